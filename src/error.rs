@@ -1,0 +1,45 @@
+//! One error type for the whole program. Its variant decides the exit code: bad input from the user
+//! (a flag, a file, a coefficient) exits 2, a failure at run time (the driver, the disk) exits 1.
+
+use std::fmt;
+
+#[derive(Debug)]
+pub enum Error {
+    /// The user's input is wrong: usage, a flag value, a mesh file, a material. Exit code 2.
+    BadInput(String),
+    /// Something failed while running: Vulkan, memory, I/O on output. Exit code 1.
+    Runtime(String),
+}
+
+pub type Result<T> = std::result::Result<T, Error>;
+
+impl Error {
+    pub fn exit_code(&self) -> i32 {
+        match self {
+            Error::BadInput(_) => 2,
+            Error::Runtime(_) => 1,
+        }
+    }
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Error::BadInput(m) | Error::Runtime(m) => f.write_str(m),
+        }
+    }
+}
+
+impl std::error::Error for Error {}
+
+/// `bad_input!("--width: {} is too large", w)` builds an [`Error::BadInput`].
+#[macro_export]
+macro_rules! bad_input {
+    ($($arg:tt)*) => { $crate::error::Error::BadInput(format!($($arg)*)) };
+}
+
+/// `runtime!("vkCreateDevice: {e}")` builds an [`Error::Runtime`].
+#[macro_export]
+macro_rules! runtime {
+    ($($arg:tt)*) => { $crate::error::Error::Runtime(format!($($arg)*)) };
+}

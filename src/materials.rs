@@ -1,0 +1,1 @@
+//! Measured material presets.

@@ -1,0 +1,1 @@
+//! The BSSRDF physics in f64: Fresnel, classical dipole, directional dipole.
