@@ -1,9 +1,17 @@
 //! translucent: subsurface scattering with the directional dipole BSSRDF, integrated over a
 //! Jensen–Buhler hierarchy that the GPU rebuilds every frame.
 
+pub mod cli;
 pub mod error;
-pub mod mesh;
-pub mod physics;
+pub mod frame;
 pub mod materials;
+pub mod mesh;
+pub mod output;
+pub mod passes;
+pub mod physics;
+pub mod profiling;
+pub mod scene;
+pub mod shaders;
+pub mod vk;
 
 pub use error::{Error, Result};

@@ -1,0 +1,12 @@
+// Push constants of the shade pass. Mirrored by `ShadeConstants` in src/passes/shade.rs; a test
+// compares the member offsets in the SPIR-V with the Rust struct.
+#ifndef SHADE_CONSTANTS_GLSL
+#define SHADE_CONSTANTS_GLSL
+layout(push_constant, std430) uniform ShadeConstants {
+    mat4 view_projection;
+    vec4 light_toward;     // xyz: unit direction toward the light (directional) or position (point); w: 0 directional, 1 point
+    vec4 light_irradiance; // rgb: irradiance at normal incidence (directional) or intensity (point)
+    vec4 eye;              // xyz: camera position
+    vec4 albedo;           // rgb: diffuse albedo of the placeholder Lambert shading; a: ambient fraction
+} pc;
+#endif

@@ -1,0 +1,108 @@
+//! The renderer and its frame: the one place where a frame's passes are listed, in order.
+
+use glam::Vec3;
+
+use crate::error::Result;
+use crate::output::HdrImage;
+use crate::passes::shade::{self, ShadeConstants, ShadePass};
+use crate::scene::Scene;
+use crate::vk::{self, Buffer, BufferUsageFlags, Context, Extent2D, GpuProfiler, Image, ImageUsageFlags, MemoryLocation, TimedScope};
+use crate::{bad_input, runtime};
+
+/// The most timestamp scopes one frame may open.
+const MAX_SCOPES: u32 = 64;
+
+pub struct Renderer {
+    // Field order is drop order: every resource before the context.
+    profiler: Option<GpuProfiler>,
+    shade: ShadePass,
+    vertices: Buffer,
+    indices: Buffer,
+    index_count: u32,
+    bounds: (Vec3, Vec3),
+    color: Image,
+    depth: Image,
+    readback: Buffer,
+    extent: Extent2D,
+    pub ctx: Context,
+}
+
+impl Renderer {
+    /// Uploads the scene's mesh and creates the targets for `width` x `height` images.
+    pub fn new(ctx: Context, scene: &Scene, width: u32, height: u32, profile: bool) -> Result<Renderer> {
+        let max = ctx.limits().max_image_dimension2_d;
+        if width == 0 || height == 0 || width > max || height > max {
+            return Err(bad_input!(
+                "image size {width}x{height}: width and height must be between 1 and {max} on {}",
+                ctx.info.name
+            ));
+        }
+        let extent = Extent2D { width, height };
+        let profiler = if profile {
+            let p = GpuProfiler::new(&ctx, MAX_SCOPES)?;
+            if p.is_none() {
+                log::warn!("--profile: {} has no timestamp support on its queue; no GPU timings", ctx.info.name);
+            }
+            p
+        } else {
+            None
+        };
+        let vertex_data = scene.mesh.vertex_data();
+        let index_count = u32::try_from(scene.mesh.indices.len()).map_err(|_| bad_input!("mesh: too many indices"))?;
+        let vertices = vk::upload_buffer(&ctx, "vertices", &vertex_data, BufferUsageFlags::VERTEX_BUFFER | BufferUsageFlags::STORAGE_BUFFER)?;
+        let indices = vk::upload_buffer(&ctx, "indices", &scene.mesh.indices, BufferUsageFlags::INDEX_BUFFER | BufferUsageFlags::STORAGE_BUFFER)?;
+        let color = Image::new_2d(
+            &ctx,
+            "hdr colour",
+            shade::COLOR_FORMAT,
+            extent,
+            1,
+            ImageUsageFlags::COLOR_ATTACHMENT | ImageUsageFlags::TRANSFER_SRC | ImageUsageFlags::STORAGE,
+        )?;
+        let depth = Image::new_2d(&ctx, "depth", shade::DEPTH_FORMAT, extent, 1, ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT)?;
+        let readback_bytes = width as u64 * height as u64 * 16;
+        let readback = Buffer::new(&ctx, "readback", readback_bytes, BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)?;
+        let shade = ShadePass::new(&ctx)?;
+        Ok(Renderer {
+            profiler,
+            shade,
+            vertices,
+            indices,
+            index_count,
+            bounds: scene.mesh.bounds(),
+            color,
+            depth,
+            readback,
+            extent,
+            ctx,
+        })
+    }
+
+    /// Renders one frame and returns its GPU timestamp scopes (empty without a profiler).
+    pub fn render_frame(&mut self, scene: &Scene) -> Result<Vec<TimedScope>> {
+        let aspect = self.extent.width as f32 / self.extent.height as f32;
+        let view_projection = scene.camera.view_projection(aspect, self.bounds);
+        let light = scene.lights.first().ok_or_else(|| runtime!("the scene has no light"))?;
+        let constants = ShadeConstants::new(view_projection, scene.camera.eye, light);
+
+        self.ctx.submit(self.profiler.as_mut(), |rec| {
+            // The frame, in order.
+            rec.begin_scope("shade");
+            self.shade.record(rec, &self.color, &self.depth, &self.vertices, &self.indices, self.index_count, &constants)?;
+            rec.end_scope();
+
+            rec.begin_scope("readback");
+            rec.copy_image_to_buffer(&self.color, &self.readback)?;
+            rec.end_scope();
+            Ok(())
+        })?;
+        Ok(self.profiler.as_mut().map(|p| p.take_scopes()).unwrap_or_default())
+    }
+
+    /// The last frame's linear radiance, read back from the GPU.
+    pub fn image(&self) -> Result<HdrImage> {
+        let count = (self.extent.width * self.extent.height) as usize;
+        let pixels = self.readback.read::<[f32; 4]>(count)?;
+        Ok(HdrImage { width: self.extent.width, height: self.extent.height, pixels })
+    }
+}

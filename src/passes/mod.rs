@@ -1,0 +1,3 @@
+//! GPU passes: each is one shader (or a few stages of one) plus one file here.
+
+pub mod shade;

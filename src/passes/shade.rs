@@ -1,0 +1,89 @@
+//! The shade pass: rasterises the mesh into the HDR colour target with depth.
+//! Reads: vertex and index buffers. Writes: colour and depth targets.
+
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, Vec4};
+
+use crate::error::Result;
+use crate::scene::Light;
+use crate::vk::{self, Buffer, Context, CullModeFlags, Format, GraphicsDesc, Image, Pipeline, PrimitiveTopology, Recorder};
+
+pub const COLOR_FORMAT: Format = Format::R32G32B32A32_SFLOAT;
+pub const DEPTH_FORMAT: Format = Format::D32_SFLOAT;
+
+/// Mirrors `ShadeConstants` in shaders/include/shade_constants.glsl (std430 push constants).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct ShadeConstants {
+    pub view_projection: Mat4,
+    pub light_toward: Vec4,
+    pub light_irradiance: Vec4,
+    pub eye: Vec4,
+    pub albedo: Vec4,
+}
+
+impl ShadeConstants {
+    pub fn new(view_projection: Mat4, eye: glam::Vec3, light: &Light) -> ShadeConstants {
+        let (toward, irradiance) = match *light {
+            Light::Directional { toward, irradiance } => (toward.normalize().extend(0.0), irradiance.extend(0.0)),
+            Light::Point { position, intensity } => (position.extend(1.0), intensity.extend(0.0)),
+        };
+        ShadeConstants {
+            view_projection,
+            light_toward: toward,
+            light_irradiance: irradiance,
+            eye: eye.extend(1.0),
+            albedo: Vec4::new(0.8, 0.8, 0.8, 0.05),
+        }
+    }
+}
+
+pub struct ShadePass {
+    pipeline: Pipeline,
+}
+
+/// Bytes per vertex: position and normal, 3 floats each.
+const VERTEX_STRIDE: u32 = 24;
+
+impl ShadePass {
+    pub fn new(ctx: &Context) -> Result<ShadePass> {
+        let pipeline = Pipeline::graphics(
+            ctx,
+            &GraphicsDesc {
+                vertex_shader: "shade.vert",
+                fragment_shader: Some("shade.frag"),
+                vertex_stride: VERTEX_STRIDE,
+                vertex_attributes: &[(0, Format::R32G32B32_SFLOAT, 0), (1, Format::R32G32B32_SFLOAT, 12)],
+                topology: PrimitiveTopology::TRIANGLE_LIST,
+                color_formats: &[COLOR_FORMAT],
+                depth_format: Some(DEPTH_FORMAT),
+                depth_test: true,
+                depth_bias: false,
+                cull_mode: CullModeFlags::NONE,
+                additive_blend: false,
+                bindings: &[],
+                push_constant_size: std::mem::size_of::<ShadeConstants>() as u32,
+            },
+        )?;
+        Ok(ShadePass { pipeline })
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &self,
+        rec: &mut Recorder,
+        color: &Image,
+        depth: &Image,
+        vertices: &Buffer,
+        indices: &Buffer,
+        index_count: u32,
+        constants: &ShadeConstants,
+    ) -> Result<()> {
+        rec.use_buffer(vertices, vk::Access::VERTEX_INPUT)?;
+        rec.use_buffer(indices, vk::Access::INDEX_INPUT)?;
+        rec.begin_rendering(&[(color, Some([0.0; 4]))], Some((depth, Some(1.0))), 0)?;
+        rec.draw(&self.pipeline, &[], vk::bytes_of(constants), Some(vertices), Some(indices), index_count, 1)?;
+        rec.end_rendering();
+        Ok(())
+    }
+}

@@ -1,0 +1,124 @@
+//! What is drawn: a mesh, a camera, lights, and the scene's scale in millimetres.
+
+use glam::{Mat4, Vec3};
+
+use crate::bad_input;
+use crate::error::Result;
+use crate::mesh::Mesh;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    pub eye: Vec3,
+    pub target: Vec3,
+    pub up: Vec3,
+    /// Vertical field of view in degrees.
+    pub fov_y_deg: f32,
+}
+
+impl Camera {
+    /// A camera looking at a bounding sphere from `direction` (eye side), so that the whole sphere
+    /// fits the vertical field of view.
+    pub fn framing(centre: Vec3, radius: f32, fov_y_deg: f32, direction: Vec3) -> Camera {
+        let radius = radius.max(1e-6);
+        let half = (fov_y_deg.to_radians() * 0.5).max(1e-3);
+        let distance = radius / half.sin() * 1.02;
+        Camera { eye: centre + direction.normalize() * distance, target: centre, up: Vec3::Y, fov_y_deg }
+    }
+
+    pub fn validate(&self) -> Result<()> {
+        let forward = self.target - self.eye;
+        if !(self.eye.is_finite() && self.target.is_finite() && self.up.is_finite()) {
+            return Err(bad_input!("camera: --eye, --target and --up must be finite"));
+        }
+        if forward.length() < 1e-9 {
+            return Err(bad_input!("camera: --eye and --target are the same point"));
+        }
+        if forward.cross(self.up).length() < 1e-6 * forward.length() * self.up.length().max(1e-30) {
+            return Err(bad_input!("camera: --up is zero or parallel to the view direction"));
+        }
+        if !(self.fov_y_deg > 0.0 && self.fov_y_deg < 180.0) {
+            return Err(bad_input!("--fov {}: must be between 0 and 180 degrees (exclusive)", self.fov_y_deg));
+        }
+        Ok(())
+    }
+
+    /// World → Vulkan clip space (y down, depth 0..1), with near/far planes around `bounds`.
+    pub fn view_projection(&self, aspect: f32, bounds: (Vec3, Vec3)) -> Mat4 {
+        let view = Mat4::look_at_rh(self.eye, self.target, self.up);
+        let centre = (bounds.0 + bounds.1) * 0.5;
+        let radius = ((bounds.1 - bounds.0).length() * 0.5).max(1e-6);
+        let distance = (centre - self.eye).length();
+        let far = distance + radius * 1.5;
+        let near = (distance - radius * 1.5).max(far * 1e-4);
+        let mut projection = Mat4::perspective_rh(self.fov_y_deg.to_radians(), aspect, near, far);
+        projection.y_axis.y = -projection.y_axis.y;
+        projection * view
+    }
+}
+
+/// A light. Directions point from the surface toward the light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Light {
+    /// `irradiance`: W/m² per RGB channel on a surface facing the light.
+    Directional { toward: Vec3, irradiance: Vec3 },
+    /// `intensity`: W/sr per RGB channel; irradiance falls off with the squared distance.
+    Point { position: Vec3, intensity: Vec3 },
+}
+
+impl Light {
+    pub fn validate(&self) -> Result<()> {
+        match self {
+            Light::Directional { toward, irradiance } => {
+                if !toward.is_finite() || toward.length() < 1e-12 {
+                    return Err(bad_input!("light direction {toward}: must be finite and non-zero"));
+                }
+                check_power(*irradiance)
+            }
+            Light::Point { position, intensity } => {
+                if !position.is_finite() {
+                    return Err(bad_input!("light position {position}: must be finite"));
+                }
+                check_power(*intensity)
+            }
+        }
+    }
+}
+
+fn check_power(v: Vec3) -> Result<()> {
+    if !v.is_finite() || v.min_element() < 0.0 {
+        return Err(bad_input!("light intensity {v}: must be finite and non-negative"));
+    }
+    Ok(())
+}
+
+/// The centre of the bounding box and the radius of the sphere around it that holds every vertex.
+pub fn bounding_sphere(positions: &[Vec3]) -> (Vec3, f32) {
+    let (lo, hi) = positions
+        .iter()
+        .fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+    let centre = (lo + hi) * 0.5;
+    let radius = positions.iter().map(|p| (*p - centre).length()).fold(0.0f32, f32::max);
+    (centre, radius)
+}
+
+pub struct Scene {
+    pub mesh: Mesh,
+    pub camera: Camera,
+    pub lights: Vec<Light>,
+    /// Millimetres per scene unit (materials are given per mm).
+    pub mm_per_unit: f32,
+}
+
+impl Scene {
+    pub fn validate(&self) -> Result<()> {
+        self.mesh.validate()?;
+        self.camera.validate()?;
+        for light in &self.lights {
+            light.validate()?;
+        }
+        if !(self.mm_per_unit.is_finite() && self.mm_per_unit > 0.0) {
+            return Err(bad_input!("--scale {}: must be a positive number of millimetres per unit", self.mm_per_unit));
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,601 @@
+//! Recording and submitting command buffers.
+//!
+//! [`Context::submit`] records one command buffer through a [`Recorder`], submits it with a fence
+//! and waits. The recorder's methods are the only way passes touch a command buffer: each declares
+//! how it uses its resources, and the recorder inserts the synchronization2 barriers.
+
+use std::cell::RefCell;
+
+use ash::vk;
+
+use super::context::Context;
+use super::pipeline::{BindingKind, Pipeline};
+use super::profiler::GpuProfiler;
+use super::resources::{aspect_of, Access, Buffer, Image, Sampler};
+use crate::error::Result;
+use crate::runtime;
+
+/// Per-context objects for recording: one command buffer, its fence and a descriptor pool that is
+/// reset after every submission (one submission in flight at a time).
+pub(crate) struct Commands {
+    pool: vk::CommandPool,
+    cmd: vk::CommandBuffer,
+    fence: vk::Fence,
+    descriptor_pool: vk::DescriptorPool,
+}
+
+const SETS_PER_SUBMIT: u32 = 512;
+
+impl Commands {
+    pub(crate) fn new(device: &ash::Device, queue_family: u32) -> Result<Commands> {
+        // SAFETY: valid device; each object is destroyed in `destroy`.
+        unsafe {
+            let pool = device
+                .create_command_pool(
+                    &vk::CommandPoolCreateInfo::default()
+                        .queue_family_index(queue_family)
+                        .flags(vk::CommandPoolCreateFlags::TRANSIENT),
+                    None,
+                )
+                .map_err(|e| runtime!("vkCreateCommandPool: {e}"))?;
+            let cmd = device
+                .allocate_command_buffers(
+                    &vk::CommandBufferAllocateInfo::default()
+                        .command_pool(pool)
+                        .level(vk::CommandBufferLevel::PRIMARY)
+                        .command_buffer_count(1),
+                )
+                .map_err(|e| runtime!("vkAllocateCommandBuffers: {e}"))?[0];
+            let fence = device
+                .create_fence(&vk::FenceCreateInfo::default(), None)
+                .map_err(|e| runtime!("vkCreateFence: {e}"))?;
+            let sizes = [
+                vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_BUFFER, descriptor_count: SETS_PER_SUBMIT * 8 },
+                vk::DescriptorPoolSize { ty: vk::DescriptorType::UNIFORM_BUFFER, descriptor_count: SETS_PER_SUBMIT },
+                vk::DescriptorPoolSize {
+                    ty: vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+                    descriptor_count: SETS_PER_SUBMIT * 2,
+                },
+                vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_IMAGE, descriptor_count: SETS_PER_SUBMIT },
+            ];
+            let descriptor_pool = device
+                .create_descriptor_pool(
+                    &vk::DescriptorPoolCreateInfo::default().max_sets(SETS_PER_SUBMIT).pool_sizes(&sizes),
+                    None,
+                )
+                .map_err(|e| runtime!("vkCreateDescriptorPool: {e}"))?;
+            Ok(Commands { pool, cmd, fence, descriptor_pool })
+        }
+    }
+
+    pub(crate) fn destroy(&mut self, device: &ash::Device) {
+        // SAFETY: called once, after the device is idle.
+        unsafe {
+            device.destroy_descriptor_pool(self.descriptor_pool, None);
+            device.destroy_fence(self.fence, None);
+            device.destroy_command_pool(self.pool, None);
+        }
+    }
+}
+
+/// A resource bound to a pipeline, with how the shader uses it.
+pub enum Bind<'a> {
+    /// Storage buffer the shader only reads.
+    Read(&'a Buffer),
+    /// Storage buffer the shader writes (and may read).
+    Write(&'a Buffer),
+    Uniform(&'a Buffer),
+    /// Combined image sampler, read in `SHADER_READ_ONLY_OPTIMAL`.
+    Sampled(&'a Image, &'a Sampler),
+    StorageImageRead(&'a Image),
+    StorageImageWrite(&'a Image),
+}
+
+/// Records commands into the context's command buffer.
+pub struct Recorder<'a> {
+    ctx: &'a Context,
+    cmd: vk::CommandBuffer,
+    descriptor_pool: vk::DescriptorPool,
+    profiler: Option<&'a mut GpuProfiler>,
+    inside_rendering: bool,
+    open_scopes: Vec<usize>,
+}
+
+impl Context {
+    /// Records commands with `record`, submits them and waits until the GPU has finished.
+    /// With a profiler, its timestamp scopes are resolved after the wait.
+    pub fn submit<T>(
+        &self,
+        profiler: Option<&mut GpuProfiler>,
+        record: impl FnOnce(&mut Recorder) -> Result<T>,
+    ) -> Result<T> {
+        let commands = self.commands.borrow();
+        let device = self.device();
+        // SAFETY: the previous submission was waited for, so the buffer and pool are free to reuse.
+        unsafe {
+            device
+                .reset_descriptor_pool(commands.descriptor_pool, vk::DescriptorPoolResetFlags::empty())
+                .map_err(|e| runtime!("vkResetDescriptorPool: {e}"))?;
+            device
+                .reset_command_pool(commands.pool, vk::CommandPoolResetFlags::empty())
+                .map_err(|e| runtime!("vkResetCommandPool: {e}"))?;
+            device
+                .begin_command_buffer(
+                    commands.cmd,
+                    &vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
+                )
+                .map_err(|e| runtime!("vkBeginCommandBuffer: {e}"))?;
+        }
+        let mut profiler = profiler;
+        if let Some(p) = profiler.as_deref_mut() {
+            p.reset();
+        }
+        let mut rec = Recorder {
+            ctx: self,
+            cmd: commands.cmd,
+            descriptor_pool: commands.descriptor_pool,
+            profiler,
+            inside_rendering: false,
+            open_scopes: Vec::new(),
+        };
+        let result = record(&mut rec);
+        if rec.inside_rendering {
+            rec.end_rendering();
+        }
+        let profiler = rec.profiler.take();
+        // SAFETY: recording finished (also on error, so the buffer is not left recording).
+        unsafe { device.end_command_buffer(commands.cmd) }.map_err(|e| runtime!("vkEndCommandBuffer: {e}"))?;
+        let value = result?;
+        let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(commands.cmd)];
+        let submit = [vk::SubmitInfo2::default().command_buffer_infos(&cmds)];
+        // SAFETY: the queue is used from this thread only; the fence is unsignalled.
+        unsafe {
+            device
+                .queue_submit2(self.queue, &submit, commands.fence)
+                .map_err(|e| runtime!("vkQueueSubmit2: {e}"))?;
+            device
+                .wait_for_fences(&[commands.fence], true, u64::MAX)
+                .map_err(|e| runtime!("vkWaitForFences: {e} (device lost?)"))?;
+            device.reset_fences(&[commands.fence]).map_err(|e| runtime!("vkResetFences: {e}"))?;
+        }
+        if let Some(p) = profiler {
+            p.resolve()?;
+        }
+        Ok(value)
+    }
+}
+
+type Transition = (
+    vk::PipelineStageFlags2,
+    vk::AccessFlags2,
+    vk::PipelineStageFlags2,
+    vk::AccessFlags2,
+    vk::ImageLayout,
+    vk::ImageLayout,
+);
+
+impl<'a> Recorder<'a> {
+    fn device(&self) -> &ash::Device {
+        self.ctx.device()
+    }
+
+    pub fn context(&self) -> &Context {
+        self.ctx
+    }
+
+    fn barrier_check(&self, what: &str) -> Result<()> {
+        if self.inside_rendering {
+            return Err(runtime!(
+                "{what} needs a barrier inside a rendering scope: declare its use before begin_rendering"
+            ));
+        }
+        Ok(())
+    }
+
+    /// Declares that the next commands use `buffer` as `access`, inserting a barrier if needed.
+    pub fn use_buffer(&mut self, buffer: &Buffer, access: Access) -> Result<()> {
+        let mut state = buffer.state.get();
+        let t = state.transition(access, false);
+        buffer.state.set(state);
+        if let Some((ss, sa, ds, da, _, _)) = t {
+            self.barrier_check(&buffer.name)?;
+            let b = [vk::BufferMemoryBarrier2::default()
+                .src_stage_mask(ss)
+                .src_access_mask(sa)
+                .dst_stage_mask(ds)
+                .dst_access_mask(da)
+                .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .buffer(buffer.raw)
+                .offset(0)
+                .size(vk::WHOLE_SIZE)];
+            // SAFETY: recording into our command buffer.
+            unsafe { self.device().cmd_pipeline_barrier2(self.cmd, &vk::DependencyInfo::default().buffer_memory_barriers(&b)) };
+        }
+        Ok(())
+    }
+
+    /// Declares that the next commands use `image` as `access` (in `access.layout`).
+    pub fn use_image(&mut self, image: &Image, access: Access) -> Result<()> {
+        let mut state = image.state.get();
+        let t: Option<Transition> = state.transition(access, true);
+        image.state.set(state);
+        if let Some((ss, sa, ds, da, old, new)) = t {
+            self.barrier_check(&image.name)?;
+            let b = [vk::ImageMemoryBarrier2::default()
+                .src_stage_mask(ss)
+                .src_access_mask(sa)
+                .dst_stage_mask(ds)
+                .dst_access_mask(da)
+                .old_layout(old)
+                .new_layout(new)
+                .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .image(image.raw)
+                .subresource_range(vk::ImageSubresourceRange {
+                    aspect_mask: aspect_of(image.format),
+                    base_mip_level: 0,
+                    level_count: 1,
+                    base_array_layer: 0,
+                    layer_count: image.layers,
+                })];
+            unsafe { self.device().cmd_pipeline_barrier2(self.cmd, &vk::DependencyInfo::default().image_memory_barriers(&b)) };
+        }
+        Ok(())
+    }
+
+    /// Makes the image's contents irrelevant: the next use may start from `UNDEFINED`.
+    pub fn discard_image(&mut self, image: &Image) {
+        let mut state = image.state.get();
+        state.layout = vk::ImageLayout::UNDEFINED;
+        image.state.set(state);
+    }
+
+    /// Allocates and writes set 0 for `pipeline`, transitioning each bound resource for `stage`.
+    fn bind(&mut self, pipeline: &Pipeline, binds: &[Bind], push_constants: &[u8], stage: Stage) -> Result<()> {
+        if binds.len() != pipeline.bindings.len() {
+            return Err(runtime!(
+                "pipeline {}: {} resources bound, {} declared",
+                pipeline.name,
+                binds.len(),
+                pipeline.bindings.len()
+            ));
+        }
+        if push_constants.len() as u32 != pipeline.push_constant_size {
+            return Err(runtime!(
+                "pipeline {}: {} bytes of push constants, {} declared",
+                pipeline.name,
+                push_constants.len(),
+                pipeline.push_constant_size
+            ));
+        }
+        for (i, (bind, kind)) in binds.iter().zip(&pipeline.bindings).enumerate() {
+            let ok = matches!(
+                (bind, kind),
+                (Bind::Read(_) | Bind::Write(_), BindingKind::StorageBuffer)
+                    | (Bind::Uniform(_), BindingKind::UniformBuffer)
+                    | (Bind::Sampled(..), BindingKind::SampledImage)
+                    | (Bind::StorageImageRead(_) | Bind::StorageImageWrite(_), BindingKind::StorageImage)
+            );
+            if !ok {
+                return Err(runtime!("pipeline {}: binding {i} does not match its declared kind {kind:?}", pipeline.name));
+            }
+            match bind {
+                Bind::Read(b) => self.use_buffer(b, stage.read())?,
+                Bind::Write(b) => self.use_buffer(b, stage.write())?,
+                Bind::Uniform(b) => self.use_buffer(b, Access { stage: stage.flags(), ..Access::UNIFORM_READ })?,
+                Bind::Sampled(img, _) => self.use_image(img, stage.sampled())?,
+                Bind::StorageImageRead(img) => self.use_image(img, stage.read())?,
+                Bind::StorageImageWrite(img) => self.use_image(img, stage.write())?,
+            }
+        }
+        let device = self.ctx.device();
+        if !binds.is_empty() {
+            let layouts = [pipeline.set_layout];
+            // SAFETY: pool and layout are valid; the pool is reset only after the fence wait.
+            let set = unsafe {
+                device.allocate_descriptor_sets(
+                    &vk::DescriptorSetAllocateInfo::default().descriptor_pool(self.descriptor_pool).set_layouts(&layouts),
+                )
+            }
+            .map_err(|e| runtime!("vkAllocateDescriptorSets ({} sets per submission): {e}", SETS_PER_SUBMIT))?[0];
+            let buffer_infos: Vec<[vk::DescriptorBufferInfo; 1]> = binds
+                .iter()
+                .map(|b| match b {
+                    Bind::Read(b) | Bind::Write(b) | Bind::Uniform(b) => {
+                        [vk::DescriptorBufferInfo { buffer: b.raw, offset: 0, range: vk::WHOLE_SIZE }]
+                    }
+                    _ => [vk::DescriptorBufferInfo::default()],
+                })
+                .collect();
+            let image_infos: Vec<[vk::DescriptorImageInfo; 1]> = binds
+                .iter()
+                .map(|b| match b {
+                    Bind::Sampled(img, sampler) => [vk::DescriptorImageInfo {
+                        sampler: sampler.raw,
+                        image_view: img.view,
+                        image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+                    }],
+                    Bind::StorageImageRead(img) | Bind::StorageImageWrite(img) => [vk::DescriptorImageInfo {
+                        sampler: vk::Sampler::null(),
+                        image_view: img.view,
+                        image_layout: vk::ImageLayout::GENERAL,
+                    }],
+                    _ => [vk::DescriptorImageInfo::default()],
+                })
+                .collect();
+            let writes: Vec<_> = binds
+                .iter()
+                .enumerate()
+                .map(|(i, b)| {
+                    let w = vk::WriteDescriptorSet::default()
+                        .dst_set(set)
+                        .dst_binding(i as u32)
+                        .descriptor_type(pipeline.bindings[i].descriptor_type());
+                    match b {
+                        Bind::Read(_) | Bind::Write(_) | Bind::Uniform(_) => w.buffer_info(&buffer_infos[i]),
+                        _ => w.image_info(&image_infos[i]),
+                    }
+                })
+                .collect();
+            unsafe {
+                device.update_descriptor_sets(&writes, &[]);
+                device.cmd_bind_descriptor_sets(self.cmd, pipeline.bind_point, pipeline.layout, 0, &[set], &[]);
+            }
+        }
+        unsafe {
+            device.cmd_bind_pipeline(self.cmd, pipeline.bind_point, pipeline.raw);
+            if !push_constants.is_empty() {
+                device.cmd_push_constants(self.cmd, pipeline.layout, pipeline.stages, 0, push_constants);
+            }
+        }
+        Ok(())
+    }
+
+    /// Runs a compute pipeline over `groups` work groups.
+    pub fn dispatch(&mut self, pipeline: &Pipeline, binds: &[Bind], push_constants: &[u8], groups: [u32; 3]) -> Result<()> {
+        let max = self.ctx.limits().max_compute_work_group_count;
+        if groups.iter().zip(max).any(|(g, m)| *g > m) {
+            return Err(runtime!("{}: dispatch of {groups:?} groups exceeds the device's {max:?}", pipeline.name));
+        }
+        self.bind(pipeline, binds, push_constants, Stage::Compute)?;
+        if groups.contains(&0) {
+            return Ok(());
+        }
+        // SAFETY: a compute pipeline and its set are bound.
+        unsafe { self.device().cmd_dispatch(self.cmd, groups[0], groups[1], groups[2]) };
+        Ok(())
+    }
+
+    /// Starts dynamic rendering into `colors` (cleared when a value is given) and `depth`,
+    /// over `layer` of layered targets. Resources that draws read must be declared first.
+    pub fn begin_rendering(
+        &mut self,
+        colors: &[(&Image, Option<[f32; 4]>)],
+        depth: Option<(&Image, Option<f32>)>,
+        layer: u32,
+    ) -> Result<()> {
+        for (img, clear) in colors {
+            if clear.is_some() {
+                self.discard_image(img);
+            }
+            self.use_image(img, Access::COLOR_ATTACHMENT)?;
+        }
+        if let Some((img, clear)) = depth {
+            if clear.is_some() {
+                self.discard_image(img);
+            }
+            self.use_image(img, Access::DEPTH_ATTACHMENT)?;
+        }
+        let extent = colors.first().map(|c| c.0.extent).or(depth.map(|d| d.0.extent)).unwrap_or_default();
+        let views = |img: &Image| -> Result<vk::ImageView> {
+            if img.layers == 1 {
+                Ok(img.view)
+            } else {
+                Err(runtime!("{}: rendering into one layer of an array image needs a per-layer view", img.name))
+            }
+        };
+        let _ = layer;
+        let color_infos: Vec<_> = colors
+            .iter()
+            .map(|(img, clear)| {
+                Ok(vk::RenderingAttachmentInfo::default()
+                    .image_view(views(img)?)
+                    .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+                    .load_op(if clear.is_some() { vk::AttachmentLoadOp::CLEAR } else { vk::AttachmentLoadOp::LOAD })
+                    .store_op(vk::AttachmentStoreOp::STORE)
+                    .clear_value(vk::ClearValue { color: vk::ClearColorValue { float32: clear.unwrap_or_default() } }))
+            })
+            .collect::<Result<_>>()?;
+        let depth_info = depth
+            .map(|(img, clear)| {
+                Ok::<_, crate::Error>(
+                    vk::RenderingAttachmentInfo::default()
+                        .image_view(views(img)?)
+                        .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
+                        .load_op(if clear.is_some() { vk::AttachmentLoadOp::CLEAR } else { vk::AttachmentLoadOp::LOAD })
+                        .store_op(vk::AttachmentStoreOp::STORE)
+                        .clear_value(vk::ClearValue {
+                            depth_stencil: vk::ClearDepthStencilValue { depth: clear.unwrap_or(1.0), stencil: 0 },
+                        }),
+                )
+            })
+            .transpose()?;
+        let area = vk::Rect2D { offset: vk::Offset2D::default(), extent };
+        let mut info =
+            vk::RenderingInfo::default().render_area(area).layer_count(1).color_attachments(&color_infos);
+        if let Some(d) = &depth_info {
+            info = info.depth_attachment(d);
+        }
+        let viewport = vk::Viewport {
+            x: 0.0,
+            y: 0.0,
+            width: extent.width as f32,
+            height: extent.height as f32,
+            min_depth: 0.0,
+            max_depth: 1.0,
+        };
+        // SAFETY: attachments are in the layouts named above (barriers recorded by use_image).
+        unsafe {
+            self.device().cmd_begin_rendering(self.cmd, &info);
+            self.device().cmd_set_viewport(self.cmd, 0, &[viewport]);
+            self.device().cmd_set_scissor(self.cmd, 0, &[area]);
+        }
+        self.inside_rendering = true;
+        Ok(())
+    }
+
+    pub fn end_rendering(&mut self) {
+        if self.inside_rendering {
+            unsafe { self.device().cmd_end_rendering(self.cmd) };
+            self.inside_rendering = false;
+        }
+    }
+
+    pub fn set_depth_bias(&mut self, constant: f32, slope: f32) {
+        unsafe { self.device().cmd_set_depth_bias(self.cmd, constant, 0.0, slope) };
+    }
+
+    /// Draws `count` vertices (or indices, with an index buffer of u32) inside a rendering scope.
+    #[allow(clippy::too_many_arguments)]
+    pub fn draw(
+        &mut self,
+        pipeline: &Pipeline,
+        binds: &[Bind],
+        push_constants: &[u8],
+        vertices: Option<&Buffer>,
+        indices: Option<&Buffer>,
+        count: u32,
+        instances: u32,
+    ) -> Result<()> {
+        if !self.inside_rendering {
+            return Err(runtime!("draw with {} outside a rendering scope", pipeline.name));
+        }
+        if let Some(v) = vertices {
+            self.use_buffer(v, Access::VERTEX_INPUT)?;
+        }
+        if let Some(i) = indices {
+            self.use_buffer(i, Access::INDEX_INPUT)?;
+        }
+        self.bind(pipeline, binds, push_constants, Stage::Graphics)?;
+        // SAFETY: graphics pipeline bound inside a rendering scope.
+        unsafe {
+            if let Some(v) = vertices {
+                self.device().cmd_bind_vertex_buffers(self.cmd, 0, &[v.raw], &[0]);
+            }
+            match indices {
+                Some(i) => {
+                    self.device().cmd_bind_index_buffer(self.cmd, i.raw, 0, vk::IndexType::UINT32);
+                    self.device().cmd_draw_indexed(self.cmd, count, instances, 0, 0, 0);
+                }
+                None => self.device().cmd_draw(self.cmd, count, instances, 0, 0),
+            }
+        }
+        Ok(())
+    }
+
+    /// Declares the reads of a later draw before its rendering scope begins.
+    pub fn prepare_draw_reads(&mut self, binds: &[Bind]) -> Result<()> {
+        for bind in binds {
+            match bind {
+                Bind::Read(b) => self.use_buffer(b, Stage::Graphics.read())?,
+                Bind::Write(b) => self.use_buffer(b, Stage::Graphics.write())?,
+                Bind::Uniform(b) => self.use_buffer(b, Access::UNIFORM_READ)?,
+                Bind::Sampled(img, _) => self.use_image(img, Stage::Graphics.sampled())?,
+                Bind::StorageImageRead(img) => self.use_image(img, Stage::Graphics.read())?,
+                Bind::StorageImageWrite(img) => self.use_image(img, Stage::Graphics.write())?,
+            }
+        }
+        Ok(())
+    }
+
+    pub fn copy_buffer(&mut self, src: &Buffer, dst: &Buffer, bytes: u64) -> Result<()> {
+        if bytes > src.size || bytes > dst.size {
+            return Err(runtime!("copy of {bytes} bytes from {} ({}) to {} ({})", src.name, src.size, dst.name, dst.size));
+        }
+        self.use_buffer(src, Access { layout: vk::ImageLayout::UNDEFINED, ..Access::TRANSFER_READ })?;
+        self.use_buffer(dst, Access { layout: vk::ImageLayout::UNDEFINED, ..Access::TRANSFER_WRITE })?;
+        let region = [vk::BufferCopy { src_offset: 0, dst_offset: 0, size: bytes }];
+        unsafe { self.device().cmd_copy_buffer(self.cmd, src.raw, dst.raw, &region) };
+        Ok(())
+    }
+
+    pub fn fill_buffer(&mut self, dst: &Buffer, value: u32) -> Result<()> {
+        self.use_buffer(dst, Access { layout: vk::ImageLayout::UNDEFINED, ..Access::TRANSFER_WRITE })?;
+        unsafe { self.device().cmd_fill_buffer(self.cmd, dst.raw, 0, vk::WHOLE_SIZE, value) };
+        Ok(())
+    }
+
+    /// Copies layer 0 of a colour image into a buffer, tightly packed, then makes it host-readable.
+    pub fn copy_image_to_buffer(&mut self, src: &Image, dst: &Buffer) -> Result<()> {
+        self.use_image(src, Access::TRANSFER_READ)?;
+        self.use_buffer(dst, Access { layout: vk::ImageLayout::UNDEFINED, ..Access::TRANSFER_WRITE })?;
+        let region = [vk::BufferImageCopy {
+            buffer_offset: 0,
+            buffer_row_length: 0,
+            buffer_image_height: 0,
+            image_subresource: vk::ImageSubresourceLayers {
+                aspect_mask: aspect_of(src.format),
+                mip_level: 0,
+                base_array_layer: 0,
+                layer_count: 1,
+            },
+            image_offset: vk::Offset3D::default(),
+            image_extent: vk::Extent3D { width: src.extent.width, height: src.extent.height, depth: 1 },
+        }];
+        unsafe {
+            self.device().cmd_copy_image_to_buffer(self.cmd, src.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, dst.raw, &region)
+        };
+        self.use_buffer(dst, Access::HOST_READ)
+    }
+
+    /// Makes a buffer written on the GPU readable by the host after the submission's fence.
+    pub fn host_read(&mut self, buffer: &Buffer) -> Result<()> {
+        self.use_buffer(buffer, Access::HOST_READ)
+    }
+
+    /// Opens a named timestamp scope (no-op without a profiler). Scopes may nest.
+    pub fn begin_scope(&mut self, name: &str) {
+        if let Some(p) = self.profiler.as_deref_mut() {
+            if let Some((pool, query, index)) = p.open(name) {
+                // SAFETY: the query was reset on the host before this submission.
+                unsafe { self.ctx.device().cmd_write_timestamp2(self.cmd, vk::PipelineStageFlags2::ALL_COMMANDS, pool, query) };
+                self.open_scopes.push(index);
+            }
+        }
+    }
+
+    pub fn end_scope(&mut self) {
+        let Some(index) = self.open_scopes.pop() else { return };
+        if let Some(p) = self.profiler.as_deref_mut() {
+            let (pool, query) = p.close(index);
+            unsafe { self.ctx.device().cmd_write_timestamp2(self.cmd, vk::PipelineStageFlags2::ALL_COMMANDS, pool, query) };
+        }
+    }
+}
+
+#[derive(Clone, Copy)]
+enum Stage {
+    Compute,
+    Graphics,
+}
+
+impl Stage {
+    fn flags(self) -> vk::PipelineStageFlags2 {
+        match self {
+            Stage::Compute => vk::PipelineStageFlags2::COMPUTE_SHADER,
+            Stage::Graphics => vk::PipelineStageFlags2::VERTEX_SHADER | vk::PipelineStageFlags2::FRAGMENT_SHADER,
+        }
+    }
+    fn read(self) -> Access {
+        Access { stage: self.flags(), ..Access::COMPUTE_READ }
+    }
+    fn write(self) -> Access {
+        Access { stage: self.flags(), ..Access::COMPUTE_WRITE }
+    }
+    fn sampled(self) -> Access {
+        Access { stage: self.flags(), ..Access::COMPUTE_SAMPLED }
+    }
+}
+
+pub(crate) type CommandsCell = RefCell<Commands>;

@@ -1,0 +1,36 @@
+//! The Vulkan layer: the only module with `unsafe` Vulkan calls. Passes use its safe types:
+//! [`Context`], [`Buffer`], [`Image`], [`Pipeline`], and a [`Recorder`] that turns declared
+//! resource uses into synchronization2 barriers.
+
+mod commands;
+mod context;
+mod pipeline;
+mod profiler;
+mod resources;
+
+pub use ash::vk::{BufferUsageFlags, CullModeFlags, Extent2D, Format, ImageUsageFlags, PrimitiveTopology};
+pub use commands::{Bind, Recorder};
+pub use context::{list_devices, Context, ContextOptions, DeviceInfo, ValidationCounts};
+pub use pipeline::{BindingKind, GraphicsDesc, Pipeline};
+pub use profiler::{GpuProfiler, TimedScope};
+pub use resources::{Access, Buffer, Image, MemoryLocation, Sampler};
+
+/// Reinterprets a plain value as bytes for push constants.
+pub fn bytes_of<T: bytemuck::Pod>(value: &T) -> &[u8] {
+    bytemuck::bytes_of(value)
+}
+
+/// A device-local buffer holding `data`, uploaded through a staging buffer.
+pub fn upload_buffer<T: bytemuck::Pod>(
+    ctx: &Context,
+    name: &str,
+    data: &[T],
+    usage: BufferUsageFlags,
+) -> crate::Result<Buffer> {
+    let bytes = std::mem::size_of_val(data) as u64;
+    let mut staging = Buffer::new(ctx, &format!("{name} (staging)"), bytes, BufferUsageFlags::TRANSFER_SRC, MemoryLocation::CpuToGpu)?;
+    staging.write(0, data)?;
+    let buffer = Buffer::new(ctx, name, bytes, usage | BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuOnly)?;
+    ctx.submit(None, |rec| rec.copy_buffer(&staging, &buffer, bytes))?;
+    Ok(buffer)
+}
