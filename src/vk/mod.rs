@@ -11,7 +11,7 @@ mod resources;
 pub use ash::vk::{BufferUsageFlags, CullModeFlags, Extent2D, Format, ImageUsageFlags, PrimitiveTopology};
 pub use commands::{Bind, Recorder};
 pub use context::{list_devices, Context, ContextOptions, DeviceInfo, ValidationCounts};
-pub use pipeline::{BindingKind, GraphicsDesc, Pipeline};
+pub use pipeline::{check_all_shaders, BindingKind, GraphicsDesc, Pipeline};
 pub use profiler::{GpuProfiler, TimedScope};
 pub use resources::{Access, Buffer, Image, MemoryLocation, Sampler};
 

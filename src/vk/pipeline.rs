@@ -78,6 +78,17 @@ impl Drop for Module<'_> {
     }
 }
 
+/// Creates and destroys a shader module for every embedded shader, so the driver (and the
+/// validation layer) see each one. Returns the names checked.
+pub fn check_all_shaders(ctx: &Context) -> Result<Vec<&'static str>> {
+    let mut names = Vec::new();
+    for name in crate::shaders::names() {
+        Module::new(ctx, name)?;
+        names.push(name);
+    }
+    Ok(names)
+}
+
 /// Creates the set-0 layout and the pipeline layout for `bindings` and `push_constant_size`.
 fn layouts(
     ctx: &Context,
