@@ -2,7 +2,7 @@
 //!
 //! `#include "x.glsl"` resolves first beside the including file, then in `shaders/include/`, where the
 //! code shared by several passes lives (BSSRDF, tree layout). A GLSL error fails the build with the
-//! file and line. Release builds are optimised; debug builds carry debug info for RenderDoc & co.
+//! file and line. Release builds are optimised; all builds keep names and debug info.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -45,10 +45,11 @@ fn main() {
         options.set_target_spirv(shaderc::SpirvVersion::V1_6);
         options.set_source_language(shaderc::SourceLanguage::GLSL);
         options.set_warnings_as_errors();
+        // Debug info always: it keeps OpName, which the layout tests read to match Rust structs with
+        // GLSL blocks, and costs the driver nothing. Release builds are optimised on top.
+        options.set_generate_debug_info();
         if release {
             options.set_optimization_level(shaderc::OptimizationLevel::Performance);
-        } else {
-            options.set_generate_debug_info();
         }
         let include_root = include_root.clone();
         options.set_include_callback(move |requested, _ty, requester, _depth| {

@@ -14,3 +14,39 @@ pub fn spirv(name: &str) -> Option<Vec<u32>> {
 pub fn names() -> impl Iterator<Item = &'static str> {
     SHADERS.iter().map(|(n, _)| *n)
 }
+
+/// Byte offsets of the members of the struct type named `type_name` in a shader's SPIR-V, read
+/// from its `OpMemberDecorate … Offset` decorations. Tests use it to check that a Rust mirror of a
+/// GLSL struct has the same layout. `None` if the shader or the name is not found.
+pub fn member_offsets(shader: &str, type_name: &str) -> Option<Vec<u32>> {
+    const OP_NAME: u32 = 5;
+    const OP_MEMBER_DECORATE: u32 = 72;
+    const DECORATION_OFFSET: u32 = 35;
+    let words = spirv(shader)?;
+    let mut type_id = None;
+    let mut offsets: Vec<(u32, u32)> = Vec::new();
+    let mut i = 5; // skip the header
+    while i < words.len() {
+        let count = (words[i] >> 16) as usize;
+        let opcode = words[i] & 0xffff;
+        if count == 0 || i + count > words.len() {
+            return None;
+        }
+        let operands = &words[i + 1..i + count];
+        if opcode == OP_NAME && operands.len() >= 2 {
+            let bytes: Vec<u8> = operands[1..].iter().flat_map(|w| w.to_le_bytes()).take_while(|b| *b != 0).collect();
+            if bytes == type_name.as_bytes() {
+                type_id = Some(operands[0]);
+            }
+        }
+        if opcode == OP_MEMBER_DECORATE && operands.len() >= 4 && operands[2] == DECORATION_OFFSET {
+            if Some(operands[0]) == type_id {
+                offsets.push((operands[1], operands[3]));
+            }
+        }
+        i += count;
+    }
+    type_id?;
+    offsets.sort();
+    Some(offsets.into_iter().map(|(_, offset)| offset).collect())
+}

@@ -1,0 +1,65 @@
+//! Bad input through the binary: each case exits 2 with an `error:` line naming the problem, and
+//! never panics or hangs.
+
+mod common;
+
+use common::{repo_path, stderr, translucent};
+
+/// Runs `render` with `args` and asserts exit code 2 and an `error:` line containing `needle`.
+fn assert_bad_input(args: &[&str], needle: &str) {
+    let out = common::output_dir().join("bad-input.png");
+    let mut full = vec!["render", "--width", "16", "--height", "16", "--out", out.to_str().unwrap()];
+    full.extend_from_slice(args);
+    let result = translucent(&full);
+    let err = stderr(&result);
+    assert_eq!(result.status.code(), Some(2), "args {args:?}: expected exit 2, stderr:\n{err}");
+    assert!(err.lines().any(|l| l.starts_with("error:")), "args {args:?}: no `error:` line in:\n{err}");
+    assert!(err.contains(needle), "args {args:?}: stderr does not mention {needle:?}:\n{err}");
+    assert!(!err.contains("panicked"), "args {args:?}: panic:\n{err}");
+}
+
+fn fixture(name: &str) -> String {
+    repo_path(&format!("tests/data/{name}")).to_string_lossy().into_owned()
+}
+
+#[test]
+fn missing_mesh_file() {
+    assert_bad_input(&["--mesh", "/nonexistent/mesh.obj"], "/nonexistent/mesh.obj");
+}
+
+#[test]
+fn malformed_obj_files() {
+    for (file, needle) in [
+        ("garbage.obj", "garbage.obj"),
+        ("truncated_face.obj", "truncated_face.obj"),
+        ("index_out_of_range.obj", "index_out_of_range.obj"),
+        ("empty.obj", "empty.obj"),
+        ("nan_vertex.obj", "nan_vertex.obj"),
+        ("zero_area.obj", "zero_area.obj"),
+    ] {
+        assert_bad_input(&["--mesh", &fixture(file)], needle);
+    }
+}
+
+#[test]
+fn bad_flag_values() {
+    assert_bad_input(&["--width", "0"], "--width");
+    assert_bad_input(&["--height", "-3"], "--height");
+    assert_bad_input(&["--width", "100000"], "100000");
+    assert_bad_input(&["--fov", "nan"], "--fov");
+    assert_bad_input(&["--fov", "180"], "--fov");
+    assert_bad_input(&["--eye", "1,2"], "--eye");
+    assert_bad_input(&["--light-dir", "0,0,0"], "light direction");
+    assert_bad_input(&["--light-intensity", "-1"], "--light-intensity");
+    assert_bad_input(&["--scale", "0"], "--scale");
+    assert_bad_input(&["--frames", "0"], "--frames");
+    assert_bad_input(&["--device", "no-such-device"], "no-such-device");
+    assert_bad_input(&["--no-such-flag"], "--no-such-flag");
+}
+
+#[test]
+fn bad_output_extension() {
+    let result = translucent(&["render", "--width", "8", "--height", "8", "--out", "picture.bmp"]);
+    assert_eq!(result.status.code(), Some(2));
+    assert!(stderr(&result).contains("picture.bmp"));
+}
