@@ -57,10 +57,7 @@ fn main() {
             let candidates = beside.into_iter().chain(std::iter::once(include_root.join(requested)));
             for candidate in candidates {
                 if let Ok(content) = std::fs::read_to_string(&candidate) {
-                    return Ok(shaderc::ResolvedInclude {
-                        resolved_name: candidate.display().to_string(),
-                        content,
-                    });
+                    return Ok(shaderc::ResolvedInclude { resolved_name: candidate.display().to_string(), content });
                 }
             }
             Err(format!("cannot find include \"{requested}\" (looked beside {requester} and in {INCLUDE_DIR}/)"))

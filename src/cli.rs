@@ -23,7 +23,7 @@ pub struct Cli {
 #[derive(Subcommand, Debug)]
 pub enum Command {
     /// Render a scene to an image (PNG: tone-mapped sRGB; EXR: linear radiance).
-    Render(RenderArgs),
+    Render(Box<RenderArgs>),
     /// List the Vulkan devices with their type, driver, API version and timestamp support.
     Devices,
 }

@@ -6,7 +6,9 @@ use crate::error::Result;
 use crate::output::HdrImage;
 use crate::passes::shade::{self, ShadeConstants, ShadePass};
 use crate::scene::Scene;
-use crate::vk::{self, Buffer, BufferUsageFlags, Context, Extent2D, GpuProfiler, Image, ImageUsageFlags, MemoryLocation, TimedScope};
+use crate::vk::{
+    self, Buffer, BufferUsageFlags, Context, Extent2D, GpuProfiler, Image, ImageUsageFlags, MemoryLocation, TimedScope,
+};
 use crate::{bad_input, runtime};
 
 /// The most timestamp scopes one frame may open.
@@ -49,8 +51,18 @@ impl Renderer {
         };
         let vertex_data = scene.mesh.vertex_data();
         let index_count = u32::try_from(scene.mesh.indices.len()).map_err(|_| bad_input!("mesh: too many indices"))?;
-        let vertices = vk::upload_buffer(&ctx, "vertices", &vertex_data, BufferUsageFlags::VERTEX_BUFFER | BufferUsageFlags::STORAGE_BUFFER)?;
-        let indices = vk::upload_buffer(&ctx, "indices", &scene.mesh.indices, BufferUsageFlags::INDEX_BUFFER | BufferUsageFlags::STORAGE_BUFFER)?;
+        let vertices = vk::upload_buffer(
+            &ctx,
+            "vertices",
+            &vertex_data,
+            BufferUsageFlags::VERTEX_BUFFER | BufferUsageFlags::STORAGE_BUFFER,
+        )?;
+        let indices = vk::upload_buffer(
+            &ctx,
+            "indices",
+            &scene.mesh.indices,
+            BufferUsageFlags::INDEX_BUFFER | BufferUsageFlags::STORAGE_BUFFER,
+        )?;
         let color = Image::new_2d(
             &ctx,
             "hdr colour",
@@ -59,9 +71,11 @@ impl Renderer {
             1,
             ImageUsageFlags::COLOR_ATTACHMENT | ImageUsageFlags::TRANSFER_SRC | ImageUsageFlags::STORAGE,
         )?;
-        let depth = Image::new_2d(&ctx, "depth", shade::DEPTH_FORMAT, extent, 1, ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT)?;
+        let depth =
+            Image::new_2d(&ctx, "depth", shade::DEPTH_FORMAT, extent, 1, ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT)?;
         let readback_bytes = width as u64 * height as u64 * 16;
-        let readback = Buffer::new(&ctx, "readback", readback_bytes, BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)?;
+        let readback =
+            Buffer::new(&ctx, "readback", readback_bytes, BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)?;
         let shade = ShadePass::new(&ctx)?;
         Ok(Renderer {
             profiler,
@@ -88,7 +102,15 @@ impl Renderer {
         self.ctx.submit(self.profiler.as_mut(), |rec| {
             // The frame, in order.
             rec.begin_scope("shade");
-            self.shade.record(rec, &self.color, &self.depth, &self.vertices, &self.indices, self.index_count, &constants)?;
+            self.shade.record(
+                rec,
+                &self.color,
+                &self.depth,
+                &self.vertices,
+                &self.indices,
+                self.index_count,
+                &constants,
+            )?;
             rec.end_scope();
 
             rec.begin_scope("readback");

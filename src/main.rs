@@ -1,9 +1,7 @@
 use clap::Parser;
 
 fn main() {
-    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn"))
-        .format_timestamp(None)
-        .init();
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).format_timestamp(None).init();
     let cli = match translucent::cli::Cli::try_parse() {
         Ok(cli) => cli,
         // clap prints `error: …` and exits 2 on usage errors, 0 for --help / --version.

@@ -93,9 +93,8 @@ fn check_power(v: Vec3) -> Result<()> {
 
 /// The centre of the bounding box and the radius of the sphere around it that holds every vertex.
 pub fn bounding_sphere(positions: &[Vec3]) -> (Vec3, f32) {
-    let (lo, hi) = positions
-        .iter()
-        .fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+    let (lo, hi) =
+        positions.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
     let centre = (lo + hi) * 0.5;
     let radius = positions.iter().map(|p| (*p - centre).length()).fold(0.0f32, f32::max);
     (centre, radius)

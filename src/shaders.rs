@@ -39,10 +39,9 @@ pub fn member_offsets(shader: &str, type_name: &str) -> Option<Vec<u32>> {
                 type_id = Some(operands[0]);
             }
         }
-        if opcode == OP_MEMBER_DECORATE && operands.len() >= 4 && operands[2] == DECORATION_OFFSET {
-            if Some(operands[0]) == type_id {
-                offsets.push((operands[1], operands[3]));
-            }
+        let is_offset = opcode == OP_MEMBER_DECORATE && operands.len() >= 4 && operands[2] == DECORATION_OFFSET;
+        if is_offset && Some(operands[0]) == type_id {
+            offsets.push((operands[1], operands[3]));
         }
         i += count;
     }

@@ -6,7 +6,9 @@ use glam::{Mat4, Vec4};
 
 use crate::error::Result;
 use crate::scene::Light;
-use crate::vk::{self, Buffer, Context, CullModeFlags, Format, GraphicsDesc, Image, Pipeline, PrimitiveTopology, Recorder};
+use crate::vk::{
+    self, Buffer, Context, CullModeFlags, Format, GraphicsDesc, Image, Pipeline, PrimitiveTopology, Recorder,
+};
 
 pub const COLOR_FORMAT: Format = Format::R32G32B32A32_SFLOAT;
 pub const DEPTH_FORMAT: Format = Format::D32_SFLOAT;

@@ -50,7 +50,10 @@ impl Commands {
                 .create_fence(&vk::FenceCreateInfo::default(), None)
                 .map_err(|e| runtime!("vkCreateFence: {e}"))?;
             let sizes = [
-                vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_BUFFER, descriptor_count: SETS_PER_SUBMIT * 8 },
+                vk::DescriptorPoolSize {
+                    ty: vk::DescriptorType::STORAGE_BUFFER,
+                    descriptor_count: SETS_PER_SUBMIT * 8,
+                },
                 vk::DescriptorPoolSize { ty: vk::DescriptorType::UNIFORM_BUFFER, descriptor_count: SETS_PER_SUBMIT },
                 vk::DescriptorPoolSize {
                     ty: vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
@@ -150,9 +153,7 @@ impl Context {
         let submit = [vk::SubmitInfo2::default().command_buffer_infos(&cmds)];
         // SAFETY: the queue is used from this thread only; the fence is unsignalled.
         unsafe {
-            device
-                .queue_submit2(self.queue, &submit, commands.fence)
-                .map_err(|e| runtime!("vkQueueSubmit2: {e}"))?;
+            device.queue_submit2(self.queue, &submit, commands.fence).map_err(|e| runtime!("vkQueueSubmit2: {e}"))?;
             device
                 .wait_for_fences(&[commands.fence], true, u64::MAX)
                 .map_err(|e| runtime!("vkWaitForFences: {e} (device lost?)"))?;
@@ -210,7 +211,9 @@ impl<'a> Recorder<'a> {
                 .offset(0)
                 .size(vk::WHOLE_SIZE)];
             // SAFETY: recording into our command buffer.
-            unsafe { self.device().cmd_pipeline_barrier2(self.cmd, &vk::DependencyInfo::default().buffer_memory_barriers(&b)) };
+            unsafe {
+                self.device().cmd_pipeline_barrier2(self.cmd, &vk::DependencyInfo::default().buffer_memory_barriers(&b))
+            };
         }
         Ok(())
     }
@@ -239,7 +242,9 @@ impl<'a> Recorder<'a> {
                     base_array_layer: 0,
                     layer_count: image.layers,
                 })];
-            unsafe { self.device().cmd_pipeline_barrier2(self.cmd, &vk::DependencyInfo::default().image_memory_barriers(&b)) };
+            unsafe {
+                self.device().cmd_pipeline_barrier2(self.cmd, &vk::DependencyInfo::default().image_memory_barriers(&b))
+            };
         }
         Ok(())
     }
@@ -278,7 +283,10 @@ impl<'a> Recorder<'a> {
                     | (Bind::StorageImageRead(_) | Bind::StorageImageWrite(_), BindingKind::StorageImage)
             );
             if !ok {
-                return Err(runtime!("pipeline {}: binding {i} does not match its declared kind {kind:?}", pipeline.name));
+                return Err(runtime!(
+                    "pipeline {}: binding {i} does not match its declared kind {kind:?}",
+                    pipeline.name
+                ));
             }
             match bind {
                 Bind::Read(b) => self.use_buffer(b, stage.read())?,
@@ -295,7 +303,9 @@ impl<'a> Recorder<'a> {
             // SAFETY: pool and layout are valid; the pool is reset only after the fence wait.
             let set = unsafe {
                 device.allocate_descriptor_sets(
-                    &vk::DescriptorSetAllocateInfo::default().descriptor_pool(self.descriptor_pool).set_layouts(&layouts),
+                    &vk::DescriptorSetAllocateInfo::default()
+                        .descriptor_pool(self.descriptor_pool)
+                        .set_layouts(&layouts),
                 )
             }
             .map_err(|e| runtime!("vkAllocateDescriptorSets ({} sets per submission): {e}", SETS_PER_SUBMIT))?[0];
@@ -353,7 +363,13 @@ impl<'a> Recorder<'a> {
     }
 
     /// Runs a compute pipeline over `groups` work groups.
-    pub fn dispatch(&mut self, pipeline: &Pipeline, binds: &[Bind], push_constants: &[u8], groups: [u32; 3]) -> Result<()> {
+    pub fn dispatch(
+        &mut self,
+        pipeline: &Pipeline,
+        binds: &[Bind],
+        push_constants: &[u8],
+        groups: [u32; 3],
+    ) -> Result<()> {
         let max = self.ctx.limits().max_compute_work_group_count;
         if groups.iter().zip(max).any(|(g, m)| *g > m) {
             return Err(runtime!("{}: dispatch of {groups:?} groups exceeds the device's {max:?}", pipeline.name));
@@ -422,8 +438,7 @@ impl<'a> Recorder<'a> {
             })
             .transpose()?;
         let area = vk::Rect2D { offset: vk::Offset2D::default(), extent };
-        let mut info =
-            vk::RenderingInfo::default().render_area(area).layer_count(1).color_attachments(&color_infos);
+        let mut info = vk::RenderingInfo::default().render_area(area).layer_count(1).color_attachments(&color_infos);
         if let Some(d) = &depth_info {
             info = info.depth_attachment(d);
         }
@@ -511,7 +526,13 @@ impl<'a> Recorder<'a> {
 
     pub fn copy_buffer(&mut self, src: &Buffer, dst: &Buffer, bytes: u64) -> Result<()> {
         if bytes > src.size || bytes > dst.size {
-            return Err(runtime!("copy of {bytes} bytes from {} ({}) to {} ({})", src.name, src.size, dst.name, dst.size));
+            return Err(runtime!(
+                "copy of {bytes} bytes from {} ({}) to {} ({})",
+                src.name,
+                src.size,
+                dst.name,
+                dst.size
+            ));
         }
         self.use_buffer(src, Access { layout: vk::ImageLayout::UNDEFINED, ..Access::TRANSFER_READ })?;
         self.use_buffer(dst, Access { layout: vk::ImageLayout::UNDEFINED, ..Access::TRANSFER_WRITE })?;
@@ -544,7 +565,13 @@ impl<'a> Recorder<'a> {
             image_extent: vk::Extent3D { width: src.extent.width, height: src.extent.height, depth: 1 },
         }];
         unsafe {
-            self.device().cmd_copy_image_to_buffer(self.cmd, src.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, dst.raw, &region)
+            self.device().cmd_copy_image_to_buffer(
+                self.cmd,
+                src.raw,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                dst.raw,
+                &region,
+            )
         };
         self.use_buffer(dst, Access::HOST_READ)
     }
@@ -559,7 +586,9 @@ impl<'a> Recorder<'a> {
         if let Some(p) = self.profiler.as_deref_mut() {
             if let Some((pool, query, index)) = p.open(name) {
                 // SAFETY: the query was reset on the host before this submission.
-                unsafe { self.ctx.device().cmd_write_timestamp2(self.cmd, vk::PipelineStageFlags2::ALL_COMMANDS, pool, query) };
+                unsafe {
+                    self.ctx.device().cmd_write_timestamp2(self.cmd, vk::PipelineStageFlags2::ALL_COMMANDS, pool, query)
+                };
                 self.open_scopes.push(index);
             }
         }
@@ -569,7 +598,9 @@ impl<'a> Recorder<'a> {
         let Some(index) = self.open_scopes.pop() else { return };
         if let Some(p) = self.profiler.as_deref_mut() {
             let (pool, query) = p.close(index);
-            unsafe { self.ctx.device().cmd_write_timestamp2(self.cmd, vk::PipelineStageFlags2::ALL_COMMANDS, pool, query) };
+            unsafe {
+                self.ctx.device().cmd_write_timestamp2(self.cmd, vk::PipelineStageFlags2::ALL_COMMANDS, pool, query)
+            };
         }
     }
 }

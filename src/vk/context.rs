@@ -176,9 +176,14 @@ fn layer_forced_from_environment() -> bool {
     std::env::var("VK_INSTANCE_LAYERS").map(|v| v.contains("VK_LAYER_KHRONOS_validation")).unwrap_or(false)
 }
 
-fn create_instance(entry: &ash::Entry, validation: bool, counts: &Arc<ValidationCounts>) -> Result<(ash::Instance, bool)> {
+fn create_instance(
+    entry: &ash::Entry,
+    validation: bool,
+    counts: &Arc<ValidationCounts>,
+) -> Result<(ash::Instance, bool)> {
     // SAFETY: plain enumeration calls on a loaded entry.
-    let layers = unsafe { entry.enumerate_instance_layer_properties() }.map_err(|e| runtime!("vkEnumerateInstanceLayerProperties: {e}"))?;
+    let layers = unsafe { entry.enumerate_instance_layer_properties() }
+        .map_err(|e| runtime!("vkEnumerateInstanceLayerProperties: {e}"))?;
     let has_layer = layers.iter().any(|l| l.layer_name_as_c_str().ok() == Some(VALIDATION_LAYER));
     if validation && !has_layer {
         return Err(runtime!(
@@ -195,7 +200,8 @@ fn create_instance(entry: &ash::Entry, validation: bool, counts: &Arc<Validation
         .api_version(vk::API_VERSION_1_3);
 
     let layer_names: Vec<*const i8> = if validation { vec![VALIDATION_LAYER.as_ptr()] } else { vec![] };
-    let extension_names: Vec<*const i8> = if messenger_wanted { vec![ash::ext::debug_utils::NAME.as_ptr()] } else { vec![] };
+    let extension_names: Vec<*const i8> =
+        if messenger_wanted { vec![ash::ext::debug_utils::NAME.as_ptr()] } else { vec![] };
 
     let enabled_features = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
     let mut validation_features = vk::ValidationFeaturesEXT::default().enabled_validation_features(&enabled_features);
@@ -224,9 +230,7 @@ fn create_instance(entry: &ash::Entry, validation: bool, counts: &Arc<Validation
 
 fn messenger_create_info(counts: &Arc<ValidationCounts>) -> vk::DebugUtilsMessengerCreateInfoEXT<'static> {
     vk::DebugUtilsMessengerCreateInfoEXT::default()
-        .message_severity(
-            vk::DebugUtilsMessageSeverityFlagsEXT::WARNING | vk::DebugUtilsMessageSeverityFlagsEXT::ERROR,
-        )
+        .message_severity(vk::DebugUtilsMessageSeverityFlagsEXT::WARNING | vk::DebugUtilsMessageSeverityFlagsEXT::ERROR)
         .message_type(
             vk::DebugUtilsMessageTypeFlagsEXT::GENERAL
                 | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION
@@ -249,7 +253,8 @@ fn find_queue_family(instance: &ash::Instance, pd: vk::PhysicalDevice) -> Option
 
 fn describe_devices(instance: &ash::Instance) -> Result<Vec<(vk::PhysicalDevice, DeviceInfo)>> {
     // SAFETY: enumeration and property queries on a valid instance.
-    let pds = unsafe { instance.enumerate_physical_devices() }.map_err(|e| runtime!("vkEnumeratePhysicalDevices: {e}"))?;
+    let pds =
+        unsafe { instance.enumerate_physical_devices() }.map_err(|e| runtime!("vkEnumeratePhysicalDevices: {e}"))?;
     let mut out = Vec::new();
     for (index, pd) in pds.into_iter().enumerate() {
         let mut driver = vk::PhysicalDeviceDriverProperties::default();
@@ -424,15 +429,20 @@ impl Context {
             missing.push("hostQueryReset");
         }
         if !missing.is_empty() {
-            return Err(fail(&debug, runtime!("device {} lacks required Vulkan features: {}", info.name, missing.join(", "))));
+            return Err(fail(
+                &debug,
+                runtime!("device {} lacks required Vulkan features: {}", info.name, missing.join(", ")),
+            ));
         }
         let has_shader_int64 = have10.shader_int64 == vk::TRUE;
 
         let features10 = vk::PhysicalDeviceFeatures::default().shader_int64(has_shader_int64);
         let mut features12 = vk::PhysicalDeviceVulkan12Features::default().host_query_reset(true);
-        let mut features13 = vk::PhysicalDeviceVulkan13Features::default().dynamic_rendering(true).synchronization2(true);
+        let mut features13 =
+            vk::PhysicalDeviceVulkan13Features::default().dynamic_rendering(true).synchronization2(true);
         let priorities = [1.0f32];
-        let queue_info = [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family).queue_priorities(&priorities)];
+        let queue_info =
+            [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family).queue_priorities(&priorities)];
         let device_info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_info)
             .enabled_features(&features10)

@@ -28,7 +28,13 @@ pub fn upload_buffer<T: bytemuck::Pod>(
     usage: BufferUsageFlags,
 ) -> crate::Result<Buffer> {
     let bytes = std::mem::size_of_val(data) as u64;
-    let mut staging = Buffer::new(ctx, &format!("{name} (staging)"), bytes, BufferUsageFlags::TRANSFER_SRC, MemoryLocation::CpuToGpu)?;
+    let mut staging = Buffer::new(
+        ctx,
+        &format!("{name} (staging)"),
+        bytes,
+        BufferUsageFlags::TRANSFER_SRC,
+        MemoryLocation::CpuToGpu,
+    )?;
     staging.write(0, data)?;
     let buffer = Buffer::new(ctx, name, bytes, usage | BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuOnly)?;
     ctx.submit(None, |rec| rec.copy_buffer(&staging, &buffer, bytes))?;

@@ -63,7 +63,8 @@ struct Module<'a> {
 
 impl<'a> Module<'a> {
     fn new(ctx: &'a Context, name: &str) -> Result<Module<'a>> {
-        let code = crate::shaders::spirv(name).ok_or_else(|| runtime!("shader {name} is not embedded in the binary"))?;
+        let code =
+            crate::shaders::spirv(name).ok_or_else(|| runtime!("shader {name} is not embedded in the binary"))?;
         let info = vk::ShaderModuleCreateInfo::default().code(&code);
         // SAFETY: the SPIR-V was produced and validated by shaderc at build time.
         let raw = unsafe { ctx.device().create_shader_module(&info, None) }
@@ -176,8 +177,10 @@ impl Pipeline {
         let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
         let (set_layout, layout) = layouts(ctx, desc.bindings, desc.push_constant_size, stages)?;
 
-        let mut stage_infos =
-            vec![vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::VERTEX).module(vert.raw).name(c"main")];
+        let mut stage_infos = vec![vk::PipelineShaderStageCreateInfo::default()
+            .stage(vk::ShaderStageFlags::VERTEX)
+            .module(vert.raw)
+            .name(c"main")];
         if let Some(frag) = &frag {
             stage_infos.push(
                 vk::PipelineShaderStageCreateInfo::default()
@@ -194,7 +197,12 @@ impl Pipeline {
         let attributes: Vec<_> = desc
             .vertex_attributes
             .iter()
-            .map(|&(location, format, offset)| vk::VertexInputAttributeDescription { location, binding: 0, format, offset })
+            .map(|&(location, format, offset)| vk::VertexInputAttributeDescription {
+                location,
+                binding: 0,
+                format,
+                offset,
+            })
             .collect();
         let mut vertex_input = vk::PipelineVertexInputStateCreateInfo::default();
         if desc.vertex_stride > 0 {
@@ -219,7 +227,8 @@ impl Pipeline {
             .color_formats
             .iter()
             .map(|_| {
-                let a = vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA);
+                let a =
+                    vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA);
                 if desc.additive_blend {
                     a.blend_enable(true)
                         .src_color_blend_factor(vk::BlendFactor::ONE)

@@ -39,7 +39,8 @@ impl GpuProfiler {
         let capacity = max_scopes * 2;
         let info = vk::QueryPoolCreateInfo::default().query_type(vk::QueryType::TIMESTAMP).query_count(capacity);
         // SAFETY: valid device.
-        let pool = unsafe { ctx.device().create_query_pool(&info, None) }.map_err(|e| runtime!("vkCreateQueryPool: {e}"))?;
+        let pool =
+            unsafe { ctx.device().create_query_pool(&info, None) }.map_err(|e| runtime!("vkCreateQueryPool: {e}"))?;
         let bits = ctx.timestamp_valid_bits;
         Ok(Some(GpuProfiler {
             shared: ctx.shared.clone(),

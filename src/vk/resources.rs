@@ -34,7 +34,8 @@ impl Access {
     const fn new(stage: vk::PipelineStageFlags2, access: vk::AccessFlags2, layout: vk::ImageLayout) -> Access {
         Access { stage, access, layout }
     }
-    pub const NONE: Access = Access::new(vk::PipelineStageFlags2::NONE, vk::AccessFlags2::NONE, vk::ImageLayout::UNDEFINED);
+    pub const NONE: Access =
+        Access::new(vk::PipelineStageFlags2::NONE, vk::AccessFlags2::NONE, vk::ImageLayout::UNDEFINED);
     pub const COMPUTE_READ: Access = Access::new(
         vk::PipelineStageFlags2::COMPUTE_SHADER,
         vk::AccessFlags2::SHADER_STORAGE_READ,
@@ -104,7 +105,8 @@ impl Access {
     );
     pub const DEPTH_ATTACHMENT: Access = Access::new(
         vk::PipelineStageFlags2::from_raw(
-            vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS.as_raw() | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS.as_raw(),
+            vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS.as_raw()
+                | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS.as_raw(),
         ),
         vk::AccessFlags2::from_raw(
             vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE.as_raw()
@@ -150,8 +152,14 @@ impl TrackedState {
         &mut self,
         next: Access,
         is_image: bool,
-    ) -> Option<(vk::PipelineStageFlags2, vk::AccessFlags2, vk::PipelineStageFlags2, vk::AccessFlags2, vk::ImageLayout, vk::ImageLayout)>
-    {
+    ) -> Option<(
+        vk::PipelineStageFlags2,
+        vk::AccessFlags2,
+        vk::PipelineStageFlags2,
+        vk::AccessFlags2,
+        vk::ImageLayout,
+        vk::ImageLayout,
+    )> {
         let layout_change = is_image && next.layout != self.layout;
         let old_layout = self.layout;
         if next.writes() || layout_change {
@@ -168,7 +176,8 @@ impl TrackedState {
             return Some((src_stage, src_access, next.stage, next.access, old_layout, next.layout));
         }
         // Read after write: make the write visible to this stage and access once.
-        let covered = self.reads_since_write.stage.contains(next.stage) && self.reads_since_write.access.contains(next.access);
+        let covered =
+            self.reads_since_write.stage.contains(next.stage) && self.reads_since_write.access.contains(next.access);
         if covered || self.last_write.stage == vk::PipelineStageFlags2::NONE {
             self.reads_since_write.stage |= next.stage;
             self.reads_since_write.access |= next.access;
@@ -176,7 +185,14 @@ impl TrackedState {
         }
         self.reads_since_write.stage |= next.stage;
         self.reads_since_write.access |= next.access;
-        Some((self.last_write.stage, self.last_write.access & WRITE_ACCESS, next.stage, next.access, self.layout, self.layout))
+        Some((
+            self.last_write.stage,
+            self.last_write.access & WRITE_ACCESS,
+            next.stage,
+            next.access,
+            self.layout,
+            self.layout,
+        ))
     }
 }
 
@@ -191,7 +207,13 @@ pub struct Buffer {
 
 impl Buffer {
     /// A buffer of `size` bytes. `CpuToGpu`/`GpuToCpu` buffers are mapped for `write`/`read`.
-    pub fn new(ctx: &Context, name: &str, size: u64, usage: vk::BufferUsageFlags, location: MemoryLocation) -> Result<Buffer> {
+    pub fn new(
+        ctx: &Context,
+        name: &str,
+        size: u64,
+        usage: vk::BufferUsageFlags,
+        location: MemoryLocation,
+    ) -> Result<Buffer> {
         let size = size.max(4);
         let device = ctx.device();
         let info = vk::BufferCreateInfo::default().size(size).usage(usage).sharing_mode(vk::SharingMode::EXCLUSIVE);
@@ -239,7 +261,11 @@ impl Buffer {
         let start = offset as usize;
         let end = start + bytes.len();
         if end > slice.len() {
-            return Err(runtime!("buffer {name}: write of {} bytes at {offset} overflows its {} bytes", bytes.len(), slice.len()));
+            return Err(runtime!(
+                "buffer {name}: write of {} bytes at {offset} overflows its {} bytes",
+                bytes.len(),
+                slice.len()
+            ));
         }
         slice[start..end].copy_from_slice(bytes);
         Ok(())
@@ -333,20 +359,21 @@ impl Image {
             }
         };
         let view_type = if layers > 1 { vk::ImageViewType::TYPE_2D_ARRAY } else { vk::ImageViewType::TYPE_2D };
-        let result = unsafe { device.bind_image_memory(raw, allocation.memory(), allocation.offset()) }.and_then(|_| {
-            let view_info = vk::ImageViewCreateInfo::default()
-                .image(raw)
-                .view_type(view_type)
-                .format(format)
-                .subresource_range(vk::ImageSubresourceRange {
-                    aspect_mask: aspect_of(format),
-                    base_mip_level: 0,
-                    level_count: 1,
-                    base_array_layer: 0,
-                    layer_count: layers,
-                });
-            unsafe { device.create_image_view(&view_info, None) }
-        });
+        let result =
+            unsafe { device.bind_image_memory(raw, allocation.memory(), allocation.offset()) }.and_then(|_| {
+                let view_info = vk::ImageViewCreateInfo::default()
+                    .image(raw)
+                    .view_type(view_type)
+                    .format(format)
+                    .subresource_range(vk::ImageSubresourceRange {
+                        aspect_mask: aspect_of(format),
+                        base_mip_level: 0,
+                        level_count: 1,
+                        base_array_layer: 0,
+                        layer_count: layers,
+                    });
+                unsafe { device.create_image_view(&view_info, None) }
+            });
         let view = match result {
             Ok(v) => v,
             Err(e) => {
