@@ -55,35 +55,35 @@ pub struct RenderArgs {
     /// Output image; the extension picks the format (.png or .exr).
     #[arg(long, short, default_value = "out.png")]
     pub out: PathBuf,
-    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..))]
     pub width: u32,
-    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..))]
     pub height: u32,
     /// Frames to render (for timing; the image is the last frame).
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100_000))]
     pub frames: u32,
     /// Millimetres per scene unit (materials are given per mm).
-    #[arg(long, default_value_t = 10.0, value_parser = positive_f32)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 10.0, value_parser = positive_f32)]
     pub scale: f32,
     /// Camera position (default: framing the mesh).
-    #[arg(long, value_parser = vec3, value_name = "X,Y,Z")]
+    #[arg(long, allow_hyphen_values = true, value_parser = vec3, value_name = "X,Y,Z")]
     pub eye: Option<Vec3>,
     /// Point the camera looks at (default: the mesh's centre).
-    #[arg(long, value_parser = vec3, value_name = "X,Y,Z")]
+    #[arg(long, allow_hyphen_values = true, value_parser = vec3, value_name = "X,Y,Z")]
     pub target: Option<Vec3>,
-    #[arg(long, value_parser = vec3, value_name = "X,Y,Z", default_value = "0,1,0")]
+    #[arg(long, allow_hyphen_values = true, value_parser = vec3, value_name = "X,Y,Z", default_value = "0,1,0")]
     pub up: Vec3,
     /// Vertical field of view in degrees.
-    #[arg(long, default_value_t = 40.0, value_parser = finite_f32)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 40.0, value_parser = finite_f32)]
     pub fov: f32,
     /// Direction toward the directional light.
-    #[arg(long, value_parser = vec3, value_name = "X,Y,Z", default_value = "-0.5,0.8,0.6")]
+    #[arg(long, allow_hyphen_values = true, value_parser = vec3, value_name = "X,Y,Z", default_value = "-0.5,0.8,0.6")]
     pub light_dir: Vec3,
     /// Irradiance at normal incidence: one value or R,G,B.
-    #[arg(long, value_parser = rgb, value_name = "I|R,G,B", default_value = "1")]
+    #[arg(long, allow_hyphen_values = true, value_parser = rgb, value_name = "I|R,G,B", default_value = "1")]
     pub light_intensity: Vec3,
     /// Exposure in stops (default: automatic from the image).
-    #[arg(long, value_parser = finite_f32)]
+    #[arg(long, allow_hyphen_values = true, value_parser = finite_f32)]
     pub exposure: Option<f32>,
     /// Print per-pass GPU times (mean, min, max, share of the frame).
     #[arg(long)]

@@ -99,6 +99,9 @@ impl Renderer {
         let light = scene.lights.first().ok_or_else(|| runtime!("the scene has no light"))?;
         let constants = ShadeConstants::new(view_projection, scene.camera.eye, light);
 
+        if let Some(p) = self.profiler.as_mut() {
+            p.begin_frame();
+        }
         self.ctx.submit(self.profiler.as_mut(), |rec| {
             // The frame, in order.
             rec.begin_scope("shade");

@@ -1,24 +1,118 @@
-//! Triangle meshes (interim: the full loader lands from the mesh branch).
+//! Triangle meshes: OBJ files through tobj (with the checks tobj does not make) and procedural
+//! shapes. One index stream is shared by positions and normals.
+
+use std::f32::consts::PI;
+use std::path::Path;
+
 use glam::Vec3;
 
+use crate::bad_input;
 use crate::error::Result;
 
+#[derive(Clone, Debug)]
 pub struct Mesh {
     pub positions: Vec<Vec3>,
     pub normals: Vec<Vec3>,
+    /// Triangle list, counter-clockwise seen from outside.
     pub indices: Vec<u32>,
 }
 
 impl Mesh {
-    pub fn sphere(radius: f32, subdivisions: u32) -> Mesh {
-        let (rings, segments) = (subdivisions * 8, subdivisions * 16);
+    /// `sphere`, `box`, `slab`, `torus`, or the path of an OBJ file.
+    pub fn from_spec(spec: &str) -> Result<Mesh> {
+        match spec {
+            "sphere" => Ok(Mesh::sphere(1.0, 48)),
+            "box" => Ok(Mesh::slab(1.0, 1.0, 1.0)),
+            "slab" => Ok(Mesh::slab(4.0, 4.0, 1.0)),
+            "torus" => Ok(Mesh::torus(1.0, 0.35, 64, 32)),
+            path => Mesh::load_obj(Path::new(path)),
+        }
+    }
+
+    /// Loads every object of an OBJ file into one mesh (triangulated, single index). Computes smooth
+    /// area-weighted normals when the file has none or has unusable ones.
+    pub fn load_obj(path: &Path) -> Result<Mesh> {
+        let shown = path.display();
+        let bytes = std::fs::read(path).map_err(|e| bad_input!("mesh {shown}: cannot read the file: {e}"))?;
+        let text = std::str::from_utf8(&bytes).map_err(|_| bad_input!("mesh {shown}: not an OBJ file (not text)"))?;
+        check_obj_text(text).map_err(|why| bad_input!("mesh {shown}: {why}"))?;
+
+        let options = tobj::LoadOptions {
+            triangulate: true,
+            single_index: true,
+            ignore_points: true,
+            ignore_lines: true,
+            ..Default::default()
+        };
+        let mut reader = std::io::BufReader::new(text.as_bytes());
+        let (models, _) = tobj::load_obj_buf(&mut reader, &options, |_| Err(tobj::LoadError::OpenFileFailed))
+            .map_err(|e| bad_input!("mesh {shown}: malformed OBJ: {e}"))?;
+
+        let mut mesh = Mesh { positions: Vec::new(), normals: Vec::new(), indices: Vec::new() };
+        let mut have_normals = true;
+        for model in &models {
+            let m = &model.mesh;
+            let base = mesh.positions.len() as u32;
+            let count = m.positions.len() / 3;
+            mesh.positions.extend(m.positions.chunks_exact(3).map(|p| Vec3::new(p[0], p[1], p[2])));
+            if m.normals.len() == m.positions.len() {
+                mesh.normals.extend(m.normals.chunks_exact(3).map(|n| Vec3::new(n[0], n[1], n[2])));
+            } else {
+                have_normals = false;
+                mesh.normals.extend(std::iter::repeat_n(Vec3::ZERO, count));
+            }
+            for &i in &m.indices {
+                if i as usize >= count {
+                    return Err(bad_input!("mesh {shown}: object '{}' has a vertex index out of range", model.name));
+                }
+                mesh.indices.push(base + i);
+            }
+        }
+        mesh.validate().map_err(|e| bad_input!("mesh {shown}: {e}"))?;
+        let usable = have_normals && mesh.normals.iter().all(|n| n.is_finite() && n.length_squared() > 1e-12);
+        if usable {
+            for n in &mut mesh.normals {
+                *n = n.normalize();
+            }
+        } else {
+            mesh.compute_normals();
+        }
+        Ok(mesh)
+    }
+
+    /// Smooth vertex normals: each the area-weighted sum of the normals of the triangles that touch
+    /// its position. Summing per position, not per vertex, keeps normals smooth where objects (or
+    /// texture seams) made tobj duplicate a vertex.
+    pub fn compute_normals(&mut self) {
+        let key = |p: Vec3| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
+        let mut sums: std::collections::HashMap<[u32; 3], Vec3> = std::collections::HashMap::new();
+        for t in self.indices.chunks_exact(3) {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| self.positions[i as usize]);
+            // The cross product's length is twice the area: it weights by area for free.
+            let n = (b - a).cross(c - a);
+            for p in [a, b, c] {
+                *sums.entry(key(p)).or_insert(Vec3::ZERO) += n;
+            }
+        }
+        // A vertex used only by degenerate triangles gets an arbitrary but valid normal.
+        self.normals = self
+            .positions
+            .iter()
+            .map(|p| sums.get(&key(*p)).and_then(|n| n.try_normalize()).unwrap_or(Vec3::Z))
+            .collect();
+    }
+
+    /// A UV sphere with exact outward normals; `rings` latitude bands, 2·rings longitude segments.
+    pub fn sphere(radius: f32, rings: u32) -> Mesh {
+        let rings = rings.max(3);
+        let segments = rings * 2;
         let mut positions = Vec::new();
         let mut normals = Vec::new();
         for i in 0..=rings {
-            let theta = std::f32::consts::PI * i as f32 / rings as f32;
+            let theta = PI * i as f32 / rings as f32;
             for j in 0..=segments {
-                let phi = 2.0 * std::f32::consts::PI * j as f32 / segments as f32;
-                let n = Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
+                let phi = 2.0 * PI * j as f32 / segments as f32;
+                let n = Vec3::new(theta.sin() * phi.cos(), theta.cos(), -theta.sin() * phi.sin());
                 positions.push(n * radius);
                 normals.push(n);
             }
@@ -28,23 +122,188 @@ impl Mesh {
             for j in 0..segments {
                 let a = i * (segments + 1) + j;
                 let b = a + segments + 1;
-                indices.extend_from_slice(&[a, a + 1, b, b, a + 1, b + 1]);
+                // Skip the zero-area triangles at the poles.
+                if i != 0 {
+                    indices.extend_from_slice(&[a, b, a + 1]);
+                }
+                if i != rings - 1 {
+                    indices.extend_from_slice(&[a + 1, b, b + 1]);
+                }
             }
         }
         Mesh { positions, normals, indices }
     }
-    pub fn from_spec(_spec: &str) -> Result<Mesh> {
-        Ok(Mesh::sphere(1.0, 4))
+
+    /// An axis-aligned box centred at the origin (x by y by z), flat normals per face; the top
+    /// face is at y = +size_y/2 (a slab seen from above).
+    pub fn slab(size_x: f32, size_z: f32, thickness: f32) -> Mesh {
+        let h = Vec3::new(size_x, thickness, size_z) * 0.5;
+        let mut mesh = Mesh { positions: Vec::new(), normals: Vec::new(), indices: Vec::new() };
+        // For each face: its normal and two tangents u, v with u × v = n (counter-clockwise).
+        let faces = [
+            (Vec3::X, Vec3::NEG_Z, Vec3::Y),
+            (Vec3::NEG_X, Vec3::Z, Vec3::Y),
+            (Vec3::Y, Vec3::Z, Vec3::X),
+            (Vec3::NEG_Y, Vec3::X, Vec3::Z),
+            (Vec3::Z, Vec3::X, Vec3::Y),
+            (Vec3::NEG_Z, Vec3::NEG_X, Vec3::Y),
+        ];
+        for (n, u, v) in faces {
+            let base = mesh.positions.len() as u32;
+            for (su, sv) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+                mesh.positions.push((n + u * su + v * sv) * h);
+                mesh.normals.push(n);
+            }
+            mesh.indices.extend_from_slice(&[base, base + 1, base + 2, base, base + 2, base + 3]);
+        }
+        mesh
     }
+
+    /// A torus around the y axis: ring radius `major`, tube radius `minor`.
+    pub fn torus(major: f32, minor: f32, segments: u32, sides: u32) -> Mesh {
+        let (segments, sides) = (segments.max(3), sides.max(3));
+        let mut mesh = Mesh { positions: Vec::new(), normals: Vec::new(), indices: Vec::new() };
+        for i in 0..=segments {
+            let phi = 2.0 * PI * i as f32 / segments as f32;
+            let ring = Vec3::new(phi.cos(), 0.0, -phi.sin());
+            for j in 0..=sides {
+                let theta = 2.0 * PI * j as f32 / sides as f32;
+                let n = ring * theta.cos() + Vec3::Y * theta.sin();
+                mesh.positions.push(ring * major + n * minor);
+                mesh.normals.push(n);
+            }
+        }
+        for i in 0..segments {
+            for j in 0..sides {
+                let a = i * (sides + 1) + j;
+                let b = a + sides + 1;
+                mesh.indices.extend_from_slice(&[a, b, a + 1, a + 1, b, b + 1]);
+            }
+        }
+        mesh
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.indices.len() / 3
+    }
+
     pub fn bounds(&self) -> (Vec3, Vec3) {
         self.positions
             .iter()
             .fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), p| (lo.min(*p), hi.max(*p)))
     }
+
+    /// Area of each triangle.
+    pub fn triangle_areas(&self) -> Vec<f32> {
+        self.indices
+            .chunks_exact(3)
+            .map(|t| {
+                let [a, b, c] = [t[0], t[1], t[2]].map(|i| self.positions[i as usize]);
+                0.5 * (b - a).cross(c - a).length()
+            })
+            .collect()
+    }
+
+    pub fn surface_area(&self) -> f32 {
+        self.triangle_areas().iter().map(|&a| a as f64).sum::<f64>() as f32
+    }
+
+    /// Checks what the renderer relies on: triangles, finite positions, indices in range, area > 0.
     pub fn validate(&self) -> Result<()> {
+        if self.indices.len() < 3 || self.positions.is_empty() {
+            return Err(bad_input!("the mesh has no triangles"));
+        }
+        if self.indices.len() % 3 != 0 {
+            return Err(bad_input!("the index count {} is not a multiple of 3", self.indices.len()));
+        }
+        if self.normals.len() != self.positions.len() {
+            return Err(bad_input!("{} normals for {} positions", self.normals.len(), self.positions.len()));
+        }
+        if let Some(i) = self.positions.iter().position(|p| !p.is_finite()) {
+            return Err(bad_input!("vertex {} has a position that is not finite: {}", i + 1, self.positions[i]));
+        }
+        if let Some(&i) = self.indices.iter().find(|&&i| i as usize >= self.positions.len()) {
+            return Err(bad_input!("vertex index {} is out of range ({} vertices)", i + 1, self.positions.len()));
+        }
+        let area = self.surface_area();
+        let (lo, hi) = self.bounds();
+        let scale = (hi - lo).max_element();
+        if !(area > 1e-12 * scale * scale) || !area.is_finite() {
+            return Err(bad_input!("the mesh has zero surface area (every triangle is degenerate)"));
+        }
         Ok(())
     }
+
+    /// Interleaved vertex data for the vertex buffer: `[px, py, pz, nx, ny, nz]` (24 bytes).
     pub fn vertex_data(&self) -> Vec<[f32; 6]> {
         self.positions.iter().zip(&self.normals).map(|(p, n)| [p.x, p.y, p.z, n.x, n.y, n.z]).collect()
+    }
+
+    pub fn scaled(mut self, factor: f32) -> Mesh {
+        for p in &mut self.positions {
+            *p *= factor;
+        }
+        self
+    }
+}
+
+/// Checks tobj is lenient about: unknown statements are skipped silently (so garbage loads as an
+/// empty mesh), and faces with fewer than 3 vertices are dropped. Also names the line.
+fn check_obj_text(text: &str) -> std::result::Result<(), String> {
+    let mut vertices = 0i64;
+    let mut faces = 0usize;
+    for (number, line) in text.lines().enumerate() {
+        let line = line.trim();
+        let mut words = line.split_whitespace();
+        let Some(keyword) = words.next() else { continue };
+        let at = number + 1;
+        match keyword {
+            "v" => {
+                let coords: Vec<&str> = words.collect();
+                if coords.len() < 3 {
+                    return Err(format!("line {at}: a vertex needs 3 coordinates: '{line}'"));
+                }
+                for c in &coords[..3] {
+                    let value: f32 = c.parse().map_err(|_| format!("line {at}: '{c}' is not a number"))?;
+                    if !value.is_finite() {
+                        return Err(format!("line {at}: vertex coordinate '{c}' is not finite"));
+                    }
+                }
+                vertices += 1;
+            }
+            "f" => {
+                let corners: Vec<&str> = words.collect();
+                if corners.len() < 3 {
+                    return Err(format!("line {at}: a face needs at least 3 vertices (truncated face?): '{line}'"));
+                }
+                for corner in corners {
+                    let index = corner.split('/').next().unwrap_or("");
+                    let i: i64 = index.parse().map_err(|_| format!("line {at}: '{corner}' is not a vertex index"))?;
+                    // OBJ indices are 1-based; negative ones count back from the last vertex so far.
+                    let resolved = if i < 0 { vertices + 1 + i } else { i };
+                    if i == 0 || resolved < 1 || resolved > vertices {
+                        return Err(format!(
+                            "line {at}: vertex index {i} is out of range ({vertices} vertices defined so far)"
+                        ));
+                    }
+                }
+                faces += 1;
+            }
+            "vn" | "vt" | "vp" | "o" | "g" | "s" | "usemtl" | "mtllib" | "l" | "p" => {}
+            k if k.starts_with('#') => {}
+            _ => return Err(format!("line {at}: not an OBJ statement: '{}'", truncate(line))),
+        }
+    }
+    if faces == 0 {
+        return Err("no faces: the file holds no triangles (empty mesh)".to_string());
+    }
+    Ok(())
+}
+
+fn truncate(s: &str) -> String {
+    if s.chars().count() > 40 {
+        format!("{}…", s.chars().take(40).collect::<String>())
+    } else {
+        s.to_string()
     }
 }

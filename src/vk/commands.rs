@@ -129,10 +129,6 @@ impl Context {
                 )
                 .map_err(|e| runtime!("vkBeginCommandBuffer: {e}"))?;
         }
-        let mut profiler = profiler;
-        if let Some(p) = profiler.as_deref_mut() {
-            p.reset();
-        }
         let mut rec = Recorder {
             ctx: self,
             cmd: commands.cmd,
@@ -465,6 +461,13 @@ impl<'a> Recorder<'a> {
             unsafe { self.device().cmd_end_rendering(self.cmd) };
             self.inside_rendering = false;
         }
+    }
+
+    /// Restricts drawing to a rectangle of the current rendering scope (tiled rendering).
+    pub fn set_scissor(&mut self, x: u32, y: u32, width: u32, height: u32) {
+        let rect =
+            vk::Rect2D { offset: vk::Offset2D { x: x as i32, y: y as i32 }, extent: vk::Extent2D { width, height } };
+        unsafe { self.device().cmd_set_scissor(self.cmd, 0, &[rect]) };
     }
 
     pub fn set_depth_bias(&mut self, constant: f32, slope: f32) {

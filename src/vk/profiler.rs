@@ -54,12 +54,14 @@ impl GpuProfiler {
         }))
     }
 
-    /// Called before recording: resets the queries on the host (Vulkan 1.2 hostQueryReset).
-    pub(crate) fn reset(&mut self) {
+    /// Starts a frame, which may span several submissions: resets the queries on the host
+    /// (Vulkan 1.2 hostQueryReset) and forgets the last frame's scopes.
+    pub fn begin_frame(&mut self) {
         // SAFETY: no submission using the pool is pending (every submit waits on its fence).
         unsafe { self.shared.device.reset_query_pool(self.pool, 0, self.capacity) };
         self.scopes.clear();
         self.next_query = 0;
+        self.resolved.clear();
     }
 
     /// Reserves the begin query of a new scope; `None` (the scope is skipped) when full.
@@ -81,7 +83,7 @@ impl GpuProfiler {
         (self.pool, q)
     }
 
-    /// Reads the timestamps of the finished submission.
+    /// Reads the timestamps written so far in this frame (after a submission has finished).
     pub(crate) fn resolve(&mut self) -> Result<()> {
         self.resolved.clear();
         if self.next_query == 0 {
@@ -113,7 +115,7 @@ impl GpuProfiler {
         Ok(())
     }
 
-    /// The scopes of the last submission, in the order they were opened.
+    /// The frame's scopes, in the order they were opened, relative to its first timestamp.
     pub fn take_scopes(&mut self) -> Vec<TimedScope> {
         std::mem::take(&mut self.resolved)
     }

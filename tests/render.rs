@@ -1,0 +1,102 @@
+//! Renders through the binary under validation, compared with committed golden images.
+//! Set TRANSLUCENT_BLESS=1 to (re)write the goldens after checking the new images by eye.
+
+mod common;
+
+use common::{output_dir, repo_path, stderr, translucent};
+use translucent::output;
+
+/// Renders `args` at 96x96 to PNG with validation on and compares it with `tests/golden/{name}.png`.
+fn render_and_compare(name: &str, args: &[&str]) {
+    let actual_path = output_dir().join(format!("{name}.png"));
+    let mut full = vec!["render", "--validation", "--width", "96", "--height", "96", "--exposure", "0"];
+    full.extend_from_slice(args);
+    full.extend_from_slice(&["--out", actual_path.to_str().unwrap()]);
+    let out = translucent(&full);
+    assert!(out.status.success(), "render {name} failed:\n{}", stderr(&out));
+    assert!(!stderr(&out).contains("vulkan"), "validation messages:\n{}", stderr(&out));
+
+    let golden_path = repo_path(&format!("tests/golden/{name}.png"));
+    let actual = image::open(&actual_path).unwrap().into_rgba8();
+    if std::env::var_os("TRANSLUCENT_BLESS").is_some() {
+        actual.save(&golden_path).unwrap();
+        return;
+    }
+    let golden = image::open(&golden_path).unwrap_or_else(|e| panic!("{}: {e}", golden_path.display())).into_rgba8();
+    let diff = output::compare(&actual, &golden).unwrap();
+    // Rasterisation differs slightly between drivers; a wrong shading or camera moves far more.
+    if diff.rmse > 2.0 || diff.differing_fraction > 0.01 {
+        let diff_path = output_dir().join(format!("{name}.diff.png"));
+        output::difference_image(&actual, &golden).save(&diff_path).unwrap();
+        panic!(
+            "{name}: differs from the golden image ({diff:?}); actual {}, difference {}",
+            actual_path.display(),
+            diff_path.display()
+        );
+    }
+}
+
+#[test]
+fn sphere_matches_golden() {
+    render_and_compare("sphere", &["--mesh", "sphere"]);
+}
+
+#[test]
+fn obj_file_matches_golden() {
+    let mesh = repo_path("tests/data/irregular.obj");
+    render_and_compare("irregular_obj", &["--mesh", mesh.to_str().unwrap(), "--light-dir", "0.3,1,0.4"]);
+}
+
+#[test]
+fn bunny_renders_clean_when_installed() {
+    let bunny = "/usr/share/glmark2/models/bunny.obj";
+    if !std::path::Path::new(bunny).exists() {
+        eprintln!("skipped: {bunny} is not installed (Debian package glmark2-data)");
+        return;
+    }
+    render_and_compare("bunny", &["--mesh", bunny]);
+}
+
+#[test]
+fn exr_output_is_linear_radiance() {
+    let path = output_dir().join("sphere.exr");
+    let out =
+        translucent(&["render", "--validation", "--width", "32", "--height", "32", "--out", path.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let img = image::open(&path).unwrap().into_rgba32f();
+    let centre = img.get_pixel(16, 16);
+    assert_eq!(centre[3], 1.0, "the sphere covers the centre");
+    assert!(centre[0] > 0.0 && centre[0].is_finite());
+    assert_eq!(img.get_pixel(0, 0)[3], 0.0, "the corner is background");
+}
+
+#[test]
+fn profile_json_has_every_pass() {
+    let json_path = output_dir().join("profile.json");
+    let png = output_dir().join("profile.png");
+    let out = translucent(&[
+        "render",
+        "--validation",
+        "--width",
+        "64",
+        "--height",
+        "64",
+        "--frames",
+        "3",
+        "--profile",
+        "--profile-out",
+        json_path.to_str().unwrap(),
+        "--out",
+        png.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(table.contains("shade") && table.contains("frame"), "table:\n{table}");
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json_path).unwrap()).unwrap();
+    let events = v["traceEvents"].as_array().unwrap();
+    for pass in ["shade", "readback"] {
+        let timed: Vec<_> = events.iter().filter(|e| e["name"] == pass).collect();
+        assert_eq!(timed.len(), 3, "{pass}: one event per frame");
+        assert!(timed.iter().all(|e| e["dur"].as_f64().unwrap() > 0.0), "{pass}: positive durations");
+    }
+}
