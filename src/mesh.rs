@@ -42,7 +42,6 @@ impl Mesh {
             single_index: true,
             ignore_points: true,
             ignore_lines: true,
-            ..Default::default()
         };
         let mut reader = std::io::BufReader::new(text.as_bytes());
         let (models, _) = tobj::load_obj_buf(&mut reader, &options, |_| Err(tobj::LoadError::OpenFileFailed))
@@ -213,7 +212,7 @@ impl Mesh {
         if self.indices.len() < 3 || self.positions.is_empty() {
             return Err(bad_input!("the mesh has no triangles"));
         }
-        if self.indices.len() % 3 != 0 {
+        if !self.indices.len().is_multiple_of(3) {
             return Err(bad_input!("the index count {} is not a multiple of 3", self.indices.len()));
         }
         if self.normals.len() != self.positions.len() {
@@ -228,7 +227,7 @@ impl Mesh {
         let area = self.surface_area();
         let (lo, hi) = self.bounds();
         let scale = (hi - lo).max_element();
-        if !(area > 1e-12 * scale * scale) || !area.is_finite() {
+        if area.is_nan() || area <= 1e-12 * scale * scale || !area.is_finite() {
             return Err(bad_input!("the mesh has zero surface area (every triangle is degenerate)"));
         }
         Ok(())
