@@ -1,1 +1,200 @@
-//! Measured material presets.
+//! Measured scattering parameters (per mm) and user-defined materials.
+//!
+//! Table A: Jensen et al. 2001 (reduced scattering only: g = 0, σs = σ's; η = 1.3, marble 1.5).
+//! Table B: Narasimhan et al. 2006, diluted media with a Henyey–Greenstein g per channel; the paper
+//! gives no index of refraction, so η = 1.3 (water-based liquids are close to 1.33).
+
+use crate::bad_input;
+use crate::error::Result;
+use crate::physics::{dipole, Diffusion, Medium};
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    pub name: String,
+    pub sigma_a: [f64; 3],
+    pub sigma_s: [f64; 3],
+    pub g: [f64; 3],
+    pub eta: f64,
+}
+
+type Row = (&'static str, [f64; 3], [f64; 3]);
+
+/// Jensen et al. 2001: name, σ's, σa.
+const JENSEN: [Row; 12] = [
+    ("Apple", [2.29, 2.39, 1.97], [0.0030, 0.0034, 0.046]),
+    ("Chicken1", [0.15, 0.21, 0.38], [0.015, 0.077, 0.19]),
+    ("Chicken2", [0.19, 0.25, 0.32], [0.018, 0.088, 0.20]),
+    ("Cream", [7.38, 5.47, 3.15], [0.0002, 0.0028, 0.0163]),
+    ("Ketchup", [0.18, 0.07, 0.03], [0.061, 0.97, 1.45]),
+    ("Marble", [2.19, 2.62, 3.00], [0.0021, 0.0041, 0.0071]),
+    ("Potato", [0.68, 0.70, 0.55], [0.0024, 0.0090, 0.12]),
+    ("Skimmilk", [0.70, 1.22, 1.90], [0.0014, 0.0025, 0.0142]),
+    ("Skin1", [0.74, 0.88, 1.01], [0.032, 0.17, 0.48]),
+    ("Skin2", [1.09, 1.59, 1.79], [0.013, 0.070, 0.145]),
+    ("Spectralon", [11.6, 20.4, 14.9], [0.00, 0.00, 0.00]),
+    ("Wholemilk", [2.55, 3.21, 3.77], [0.0011, 0.0024, 0.014]),
+];
+
+/// Narasimhan et al. 2006: name, σs, σa, g.
+const NARASIMHAN: [(&str, [f64; 3], [f64; 3], [f64; 3]); 35] = [
+    ("Lowfat Milk", [0.9124, 1.0744, 1.2492], [0.0002, 0.0004, 0.0008], [0.932, 0.902, 0.859]),
+    ("Reduced Milk", [1.0748, 1.2209, 1.3931], [0.0002, 0.0004, 0.0010], [0.819, 0.797, 0.746]),
+    ("Regular Milk", [1.1873, 1.3293, 1.4589], [0.0001, 0.0003, 0.0013], [0.750, 0.714, 0.681]),
+    ("Espresso", [0.2707, 0.2828, 0.2970], [0.1669, 0.2287, 0.3078], [0.907, 0.896, 0.880]),
+    ("Mint Mocha Coffee", [0.0916, 0.1081, 0.1460], [0.0984, 0.1519, 0.2040], [0.910, 0.907, 0.914]),
+    ("Lowfat Soy Milk", [0.1418, 0.1620, 0.2715], [0.0001, 0.0005, 0.0025], [0.850, 0.853, 0.842]),
+    ("Regular Soy Milk", [0.2433, 0.2714, 0.4563], [0.0001, 0.0005, 0.0034], [0.873, 0.858, 0.832]),
+    ("Lowfat Chocolate Milk", [0.4277, 0.4998, 0.5723], [0.0005, 0.0016, 0.0068], [0.934, 0.927, 0.916]),
+    ("Regular Chocolate Milk", [0.7352, 0.9142, 1.0588], [0.0007, 0.0030, 0.0100], [0.862, 0.838, 0.806]),
+    ("Coke", [0.0177, 0.0208, 0.0000], [0.6966, 1.1480, 1.7169], [0.965, 0.972, 0.000]),
+    ("Pepsi", [0.0058, 0.0141, 0.0000], [0.6375, 0.9849, 1.4420], [0.926, 0.979, 0.000]),
+    ("Sprite", [0.0069, 0.0089, 0.0089], [0.1230, 0.1194, 0.1306], [0.943, 0.953, 0.952]),
+    ("Gatorade", [0.2392, 0.2927, 0.3745], [0.1617, 0.1258, 0.0579], [0.933, 0.933, 0.935]),
+    ("Chardonnay", [0.0030, 0.0047, 0.0069], [0.1547, 0.1701, 0.3443], [0.914, 0.958, 0.975]),
+    ("White Zinfandel", [0.0031, 0.0048, 0.0066], [0.1732, 0.2322, 0.2847], [0.919, 0.943, 0.972]),
+    ("Merlot", [0.0053, 0.0000, 0.0000], [0.7586, 1.6429, 1.9196], [0.974, 0.000, 0.000]),
+    ("Budweiser Beer", [0.0037, 0.0069, 0.0074], [0.1449, 0.3141, 0.7286], [0.917, 0.956, 0.982]),
+    ("Coors Light Beer", [0.0027, 0.0055, 0.0000], [0.0268, 0.0608, 0.1521], [0.918, 0.966, 0.000]),
+    ("Clorox", [0.1425, 0.1723, 0.1928], [0.0175, 0.0777, 0.1372], [0.912, 0.905, 0.892]),
+    ("Apple Juice", [0.0201, 0.0243, 0.0323], [0.1014, 0.1858, 0.4084], [0.947, 0.949, 0.945]),
+    ("Cranberry Juice", [0.0128, 0.0155, 0.0196], [0.2572, 0.6145, 0.8104], [0.947, 0.951, 0.974]),
+    ("Grape Juice", [0.0072, 0.0000, 0.0000], [0.5428, 1.2500, 1.5300], [0.961, 0.000, 0.000]),
+    ("Ruby Grapefruit Juice", [0.1617, 0.1606, 0.1669], [0.0896, 0.1911, 0.2636], [0.929, 0.929, 0.931]),
+    ("White Grapefruit Juice", [0.3513, 0.3669, 0.5237], [0.0096, 0.0131, 0.0395], [0.548, 0.545, 0.565]),
+    ("Shampoo", [0.0104, 0.0114, 0.0147], [0.0184, 0.0596, 0.0805], [0.910, 0.905, 0.920]),
+    ("Strawberry Shampoo", [0.0028, 0.0032, 0.0033], [0.0189, 0.0756, 0.0989], [0.927, 0.935, 0.994]),
+    ("Head & Shoulders Shampoo", [0.2791, 0.2890, 0.3086], [0.0883, 0.1637, 0.2125], [0.911, 0.896, 0.884]),
+    ("Lemon Tea", [0.0798, 0.0898, 0.1073], [0.2602, 0.4902, 0.7727], [0.946, 0.946, 0.949]),
+    ("Orange Juice Powder", [0.1928, 0.2132, 0.2259], [0.1449, 0.3441, 0.7863], [0.919, 0.918, 0.922]),
+    ("Pink Lemonade", [0.1235, 0.1334, 0.1305], [0.1165, 0.2366, 0.3195], [0.902, 0.902, 0.904]),
+    ("Cappuccino Powder", [0.0654, 0.0882, 0.1568], [0.1920, 0.2654, 0.3272], [0.849, 0.843, 0.926]),
+    ("Salt Powder", [0.2485, 0.2822, 0.3216], [0.5115, 0.5863, 0.6147], [0.802, 0.793, 0.821]),
+    ("Sugar Powder", [0.0145, 0.0162, 0.0202], [0.0650, 0.1597, 0.2578], [0.921, 0.919, 0.931]),
+    ("Suisse Mocha", [0.3223, 0.3583, 0.4148], [0.1875, 0.2893, 0.3796], [0.907, 0.894, 0.888]),
+    ("Pacific Ocean Surface Water", [0.1800, 0.1834, 0.2281], [3.1845, 3.1324, 3.0147], [0.902, 0.825, 0.914]),
+];
+
+/// Lower case with spaces, underscores, hyphens and '&' removed: "Regular Milk" = "regular-milk".
+fn key(name: &str) -> String {
+    name.chars().filter(|c| c.is_alphanumeric()).flat_map(char::to_lowercase).collect()
+}
+
+impl Material {
+    pub fn presets() -> Vec<Material> {
+        let jensen = JENSEN.iter().map(|(name, s_reduced, a)| Material {
+            name: name.to_string(),
+            sigma_a: *a,
+            sigma_s: *s_reduced,
+            g: [0.0; 3],
+            eta: if *name == "Marble" { 1.5 } else { 1.3 },
+        });
+        let narasimhan = NARASIMHAN.iter().map(|(name, s, a, g)| Material {
+            name: name.to_string(),
+            sigma_a: *a,
+            sigma_s: *s,
+            g: *g,
+            eta: 1.3,
+        });
+        jensen.chain(narasimhan).collect()
+    }
+
+    /// A preset by name, ignoring case, spaces, underscores and hyphens.
+    pub fn find(name: &str) -> Result<Material> {
+        let k = key(name);
+        Material::presets()
+            .into_iter()
+            .find(|m| key(&m.name) == k)
+            .ok_or_else(|| bad_input!("--material {name}: unknown material; `translucent materials` lists the presets"))
+    }
+
+    /// A material from user coefficients (per mm), validated.
+    pub fn custom(sigma_a: [f64; 3], sigma_s: [f64; 3], g: [f64; 3], eta: f64) -> Result<Material> {
+        let m = Material { name: "custom".into(), sigma_a, sigma_s, g, eta };
+        m.validate()?;
+        Ok(m)
+    }
+
+    /// Rejects values the models cannot take, naming the offending one.
+    pub fn validate(&self) -> Result<()> {
+        for (what, values) in [("sigma_a", self.sigma_a), ("sigma_s", self.sigma_s)] {
+            for (ch, v) in values.iter().enumerate() {
+                if !v.is_finite() || *v < 0.0 {
+                    return Err(bad_input!("{}: {what} = {v} in channel {ch} must be finite and ≥ 0", self.name));
+                }
+            }
+        }
+        for (ch, g) in self.g.iter().enumerate() {
+            if !g.is_finite() || g.abs() >= 1.0 {
+                return Err(bad_input!("{}: g = {g} in channel {ch} must lie in (−1, 1)", self.name));
+            }
+        }
+        if !self.eta.is_finite() || self.eta <= 0.0 {
+            return Err(bad_input!("{}: eta = {} must be finite and > 0", self.name, self.eta));
+        }
+        Ok(())
+    }
+
+    pub fn channel(&self, ch: usize) -> Medium {
+        Medium { sigma_a: self.sigma_a[ch], sigma_s: self.sigma_s[ch], g: self.g[ch], eta: self.eta }
+    }
+
+    /// Coefficients per scene unit, for a scene of `mm_per_unit` millimetres per unit.
+    pub fn per_scene_unit(&self, mm_per_unit: f64) -> Material {
+        Material {
+            sigma_a: self.sigma_a.map(|v| v * mm_per_unit),
+            sigma_s: self.sigma_s.map(|v| v * mm_per_unit),
+            ..self.clone()
+        }
+    }
+
+    /// Channels where σ's = 0: diffusion does not apply and they get no subsurface light.
+    pub fn pure_absorber_channels(&self) -> Vec<usize> {
+        (0..3).filter(|&ch| !self.channel(ch).constants(Diffusion::Classical).transports).collect()
+    }
+
+    /// A warning for pure-absorber channels, if any.
+    pub fn warning(&self) -> Option<String> {
+        let channels = self.pure_absorber_channels();
+        (!channels.is_empty()).then(|| {
+            let names: Vec<&str> = channels.iter().map(|&c| ["red", "green", "blue"][c]).collect();
+            format!(
+                "{}: no scattering in the {} channel(s) (σs = 0): no subsurface transport there",
+                self.name,
+                names.join(", ")
+            )
+        })
+    }
+}
+
+/// The `translucent materials` table: per channel σ's, σa, α', mean free path, 1/σtr and Rd.
+pub fn materials_table() -> String {
+    let mut out = format!(
+        "{:<28} {:>4}  {:>24}  {:>24}  {:>20}  {:>24}  {:>24}  {:>20}\n",
+        "material",
+        "eta",
+        "sigma_s' [1/mm] R G B",
+        "sigma_a [1/mm] R G B",
+        "alpha' R G B",
+        "mfp [mm] R G B",
+        "1/sigma_tr [mm] R G B",
+        "Rd R G B"
+    );
+    let fmt3 = |v: [f64; 3], prec: usize| v.map(|x| format!("{x:.prec$}")).join(" ");
+    for m in Material::presets() {
+        let c: Vec<_> = (0..3).map(|ch| m.channel(ch).constants(Diffusion::Classical)).collect();
+        let pick = |f: &dyn Fn(&crate::physics::ChannelConstants) -> f64| [f(&c[0]), f(&c[1]), f(&c[2])];
+        let inv = |v: f64| if v > 0.0 { 1.0 / v } else { f64::INFINITY };
+        out += &format!(
+            "{:<28} {:>4.2}  {:>24}  {:>24}  {:>20}  {:>24}  {:>24}  {:>20}\n",
+            m.name,
+            m.eta,
+            fmt3(pick(&|c| c.sigma_s_reduced), 4),
+            fmt3(pick(&|c| c.sigma_a), 4),
+            fmt3(pick(&|c| c.alpha_reduced), 3),
+            fmt3(pick(&|c| inv(c.sigma_t_reduced)), 3),
+            fmt3(pick(&|c| inv(c.dipole_sigma_tr)), 2),
+            fmt3(pick(&|c| if c.transports { dipole::total_rd(c.alpha_reduced, c.a_dipole) } else { 0.0 }), 3),
+        );
+    }
+    out
+}

@@ -37,12 +37,8 @@ impl Mesh {
         let text = std::str::from_utf8(&bytes).map_err(|_| bad_input!("mesh {shown}: not an OBJ file (not text)"))?;
         check_obj_text(text).map_err(|why| bad_input!("mesh {shown}: {why}"))?;
 
-        let options = tobj::LoadOptions {
-            triangulate: true,
-            single_index: true,
-            ignore_points: true,
-            ignore_lines: true,
-        };
+        let options =
+            tobj::LoadOptions { triangulate: true, single_index: true, ignore_points: true, ignore_lines: true };
         let mut reader = std::io::BufReader::new(text.as_bytes());
         let (models, _) = tobj::load_obj_buf(&mut reader, &options, |_| Err(tobj::LoadError::OpenFileFailed))
             .map_err(|e| bad_input!("mesh {shown}: malformed OBJ: {e}"))?;

@@ -1,1 +1,164 @@
-//! The BSSRDF physics in f64: Fresnel, classical dipole, directional dipole.
+//! The BSSRDF physics in f64, the reference for tests and tools. `shaders/include/bssrdf.glsl`
+//! mirrors it in f32 for the GPU; [`GpuChannel`] carries the constants computed here to it.
+//!
+//! Conventions (see `shared/reference/bssrdf.md`): per colour channel, coefficients in mm⁻¹,
+//! lengths in mm, normals outward, ωi from the surface toward the light, η = n_inside/n_outside.
+
+pub mod dipole;
+pub mod dirpole;
+pub mod fresnel;
+
+use bytemuck::{Pod, Zeroable};
+
+/// Which diffusion coefficient the directional dipole uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Diffusion {
+    /// D = 1/(3σ't), as in the authors' program.
+    #[default]
+    Classical,
+    /// D = (2σa + σ's)/(3σ't²).
+    Alternative,
+}
+
+/// Which BSSRDF.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Model {
+    /// Frisvad, Hachisuka, Kjeldsen 2014.
+    #[default]
+    Directional,
+    /// Jensen, Marschner, Levoy, Hanrahan 2001.
+    Dipole,
+}
+
+/// One colour channel of a medium.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Medium {
+    pub sigma_a: f64,
+    pub sigma_s: f64,
+    pub g: f64,
+    pub eta: f64,
+}
+
+/// Everything both models need about one channel, computed once in f64.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ChannelConstants {
+    pub eta: f64,
+    pub sigma_a: f64,
+    /// Unreduced extinction σt = σa + σs (back-lit real-source distance).
+    pub sigma_t: f64,
+    /// σ's = σs(1 − g).
+    pub sigma_s_reduced: f64,
+    /// σ't = σa + σ's.
+    pub sigma_t_reduced: f64,
+    /// α' = σ's/σ't.
+    pub alpha_reduced: f64,
+    /// Diffusion coefficient of the directional dipole.
+    pub d: f64,
+    /// σtr = √(σa/D) for the directional dipole.
+    pub sigma_tr: f64,
+    /// Extrapolation distance de = 2.131 D/√α'.
+    pub de: f64,
+    /// Directional dipole boundary constant A = (1 − CE(η))/(2Cφ(η)).
+    pub a_dirpole: f64,
+    pub c_phi: f64,
+    pub c_e: f64,
+    /// Normalisation N = 1/(4Cφ(1/η)).
+    pub n_norm: f64,
+    /// Classical dipole: σtr = √(3σaσ't), zr = 1/σ't, zv = zr(1 + 4A/3), A = (1+Fdr)/(1−Fdr).
+    pub dipole_sigma_tr: f64,
+    pub zr: f64,
+    pub zv: f64,
+    pub a_dipole: f64,
+    /// False for a pure absorber (σ's = 0): diffusion does not apply, Sd = 0 in this channel.
+    pub transports: bool,
+}
+
+impl Medium {
+    pub fn constants(&self, diffusion: Diffusion) -> ChannelConstants {
+        let sigma_s_reduced = self.sigma_s * (1.0 - self.g);
+        let sigma_t_reduced = self.sigma_a + sigma_s_reduced;
+        let transports = sigma_s_reduced > 0.0 && sigma_t_reduced > 0.0;
+        // A pure absorber keeps finite placeholders; `transports` makes every Sd zero.
+        let safe_t = if transports { sigma_t_reduced } else { 1.0 };
+        let alpha_reduced = if transports { sigma_s_reduced / sigma_t_reduced } else { 0.0 };
+        let d = match diffusion {
+            Diffusion::Classical => 1.0 / (3.0 * safe_t),
+            Diffusion::Alternative => (2.0 * self.sigma_a + sigma_s_reduced) / (3.0 * safe_t * safe_t),
+        };
+        let d = if transports { d } else { 1.0 / 3.0 };
+        let c_phi = fresnel::c_phi(self.eta);
+        let c_e = fresnel::c_e(self.eta);
+        let a_dipole = fresnel::dipole_a(self.eta);
+        let zr = 1.0 / safe_t;
+        ChannelConstants {
+            eta: self.eta,
+            sigma_a: self.sigma_a,
+            sigma_t: self.sigma_a + self.sigma_s,
+            sigma_s_reduced,
+            sigma_t_reduced,
+            alpha_reduced,
+            d,
+            sigma_tr: (self.sigma_a / d).sqrt(),
+            de: if transports { 2.131 * d / alpha_reduced.sqrt() } else { 1.0 },
+            a_dirpole: (1.0 - c_e) / (2.0 * c_phi),
+            c_phi,
+            c_e,
+            n_norm: 1.0 / (4.0 * fresnel::c_phi(1.0 / self.eta)),
+            dipole_sigma_tr: (3.0 * self.sigma_a * safe_t).sqrt(),
+            zr,
+            zv: zr * (1.0 + 4.0 * a_dipole / 3.0),
+            a_dipole,
+            transports,
+        }
+    }
+}
+
+/// The per-channel constants as the GPU reads them: 16 floats, std430 = C layout. Mirrors
+/// `BssrdfChannel` in `shaders/include/bssrdf.glsl` (checked by a layout test).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuChannel {
+    pub eta: f32,
+    pub sigma_tr: f32,
+    pub d: f32,
+    pub de: f32,
+    pub a_dirpole: f32,
+    pub c_phi: f32,
+    pub c_e: f32,
+    /// N/(4π²), the directional dipole's leading factor.
+    pub n_over_4pi2: f32,
+    /// (1/(3σt))², the back-lit real-source offset.
+    pub back_lit_dr2: f32,
+    /// α'/(4π), the classical dipole's leading factor.
+    pub dipole_scale: f32,
+    pub dipole_sigma_tr: f32,
+    pub zr: f32,
+    pub zv: f32,
+    /// 1 where diffusion applies, 0 for a pure-absorber channel.
+    pub transports: f32,
+    pub _pad: [f32; 2],
+}
+
+impl From<&ChannelConstants> for GpuChannel {
+    fn from(c: &ChannelConstants) -> GpuChannel {
+        let pi = std::f64::consts::PI;
+        let inv3t = if c.sigma_t > 0.0 { 1.0 / (3.0 * c.sigma_t) } else { 0.0 };
+        GpuChannel {
+            eta: c.eta as f32,
+            sigma_tr: c.sigma_tr as f32,
+            d: c.d as f32,
+            de: c.de as f32,
+            a_dirpole: c.a_dirpole as f32,
+            c_phi: c.c_phi as f32,
+            c_e: c.c_e as f32,
+            n_over_4pi2: (c.n_norm / (4.0 * pi * pi)) as f32,
+            back_lit_dr2: (inv3t * inv3t) as f32,
+            dipole_scale: (c.alpha_reduced / (4.0 * pi)) as f32,
+            dipole_sigma_tr: c.dipole_sigma_tr as f32,
+            zr: c.zr as f32,
+            zv: c.zv as f32,
+            transports: if c.transports { 1.0 } else { 0.0 },
+            _pad: [0.0; 2],
+        }
+    }
+}
