@@ -18,6 +18,8 @@ pub struct Material {
 }
 
 type Row = (&'static str, [f64; 3], [f64; 3]);
+/// name, σs, σa, g.
+type RowWithG = (&'static str, [f64; 3], [f64; 3], [f64; 3]);
 
 /// Jensen et al. 2001: name, σ's, σa.
 const JENSEN: [Row; 12] = [
@@ -36,7 +38,7 @@ const JENSEN: [Row; 12] = [
 ];
 
 /// Narasimhan et al. 2006: name, σs, σa, g.
-const NARASIMHAN: [(&str, [f64; 3], [f64; 3], [f64; 3]); 35] = [
+const NARASIMHAN: [RowWithG; 35] = [
     ("Lowfat Milk", [0.9124, 1.0744, 1.2492], [0.0002, 0.0004, 0.0008], [0.932, 0.902, 0.859]),
     ("Reduced Milk", [1.0748, 1.2209, 1.3931], [0.0002, 0.0004, 0.0010], [0.819, 0.797, 0.746]),
     ("Regular Milk", [1.1873, 1.3293, 1.4589], [0.0001, 0.0003, 0.0013], [0.750, 0.714, 0.681]),
