@@ -24,7 +24,7 @@ fn fresnel_r_plus_t_is_one_and_normal_incidence_closed_form() {
 
 #[test]
 fn total_internal_reflection_beyond_the_critical_angle() {
-    let eta = 1.0 / 1.5; // leaving glass
+    let eta: f64 = 1.0 / 1.5; // leaving glass
     let critical = eta.asin();
     assert_eq!(fresnel::reflectance(eta, (critical + 1e-3).cos()), 1.0);
     assert!(fresnel::reflectance(eta, (critical - 1e-2).cos()) < 1.0);
