@@ -18,3 +18,22 @@ fn shade_constants_match_glsl() {
     assert_eq!(glsl, rust);
     assert_eq!(size_of::<ShadeConstants>(), 128);
 }
+
+#[test]
+fn bssrdf_structs_match_glsl() {
+    use translucent::passes::bssrdf_eval::BssrdfQueryGpu;
+    use translucent::physics::GpuChannel;
+    let channel = member_offsets("bssrdf_eval.comp", "BssrdfChannel").expect("BssrdfChannel");
+    assert_eq!(channel, (0..16).map(|i| i * 4).collect::<Vec<u32>>());
+    assert_eq!(size_of::<GpuChannel>(), 64);
+    let query = member_offsets("bssrdf_eval.comp", "BssrdfQuery").expect("BssrdfQuery");
+    let rust = vec![
+        offset_of!(BssrdfQueryGpu, channel) as u32,
+        offset_of!(BssrdfQueryGpu, xi) as u32,
+        offset_of!(BssrdfQueryGpu, ni) as u32,
+        offset_of!(BssrdfQueryGpu, wi) as u32,
+        offset_of!(BssrdfQueryGpu, xo) as u32,
+        offset_of!(BssrdfQueryGpu, no) as u32,
+    ];
+    assert_eq!(query, rust);
+}

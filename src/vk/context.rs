@@ -153,10 +153,12 @@ unsafe extern "system" fn debug_callback(
         log::debug!("vulkan {types:?} [{id}]: {message}");
     } else if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR) {
         counts.errors.fetch_add(1, Ordering::SeqCst);
-        log::error!("vulkan {types:?} [{id}]: {message}");
+        // Straight to stderr, not through `log`: a finding must show whatever the logger setup
+        // (tests have none).
+        eprintln!("vulkan validation error [{id}]: {message}");
     } else if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::WARNING) {
         counts.warnings.fetch_add(1, Ordering::SeqCst);
-        log::warn!("vulkan {types:?} [{id}]: {message}");
+        eprintln!("vulkan validation warning [{id}]: {message}");
     } else {
         log::debug!("vulkan {types:?} [{id}]: {message}");
     }
@@ -425,6 +427,10 @@ impl Context {
         if have13.synchronization2 == vk::FALSE {
             missing.push("synchronization2");
         }
+        if have13.maintenance4 == vk::FALSE {
+            // Optimised SPIR-V 1.6 declares work-group sizes with LocalSizeId, which needs it.
+            missing.push("maintenance4");
+        }
         if have12.host_query_reset == vk::FALSE {
             missing.push("hostQueryReset");
         }
@@ -438,8 +444,10 @@ impl Context {
 
         let features10 = vk::PhysicalDeviceFeatures::default().shader_int64(has_shader_int64);
         let mut features12 = vk::PhysicalDeviceVulkan12Features::default().host_query_reset(true);
-        let mut features13 =
-            vk::PhysicalDeviceVulkan13Features::default().dynamic_rendering(true).synchronization2(true);
+        let mut features13 = vk::PhysicalDeviceVulkan13Features::default()
+            .dynamic_rendering(true)
+            .synchronization2(true)
+            .maintenance4(true);
         let priorities = [1.0f32];
         let queue_info =
             [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family).queue_priorities(&priorities)];

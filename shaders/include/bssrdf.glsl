@@ -1,0 +1,115 @@
+// The BSSRDF in f32, mirroring src/physics/ (f64): exact Fresnel, the classical dipole
+// (Jensen et al. 2001) and the directional dipole (Frisvad et al. 2014). Material constants come
+// precomputed in f64 on the CPU (BssrdfChannel = GpuChannel in src/physics/mod.rs): the 3C2
+// polynomial behind CE cancels from ~1600 to ~0.4 and must not be evaluated in f32.
+// Conventions: normals outward, wi from the surface toward the light, eta = n_inside/n_outside.
+#ifndef BSSRDF_GLSL
+#define BSSRDF_GLSL
+
+struct BssrdfChannel {
+    float eta;
+    float sigma_tr;
+    float d;
+    float de;
+    float a_dirpole;
+    float c_phi;
+    float c_e;
+    float n_over_4pi2;
+    float back_lit_dr2;
+    float dipole_scale;
+    float dipole_sigma_tr;
+    float zr;
+    float zv;
+    float transports;
+    float pad0;
+    float pad1;
+};
+
+// Unpolarised Fresnel reflectance for relative index eta, cos_i to the normal; 1 under total
+// internal reflection.
+float fresnel_reflectance(float eta, float cos_i) {
+    cos_i = min(abs(cos_i), 1.0);
+    float sin_t2 = (1.0 - cos_i * cos_i) / (eta * eta);
+    if (sin_t2 >= 1.0) return 1.0;
+    float cos_t = sqrt(1.0 - sin_t2);
+    float rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    float rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    return 0.5 * (rs * rs + rp * rp);
+}
+
+float fresnel_transmittance(float eta, float cos_i) {
+    return 1.0 - fresnel_reflectance(eta, cos_i);
+}
+
+// Classical dipole Sd = Rd(r)/pi, Rd = (a'/4pi)[zr(1+s dr)e^{-s dr}/dr^3 + zv(1+s dv)e^{-s dv}/dv^3].
+float dipole_sd(BssrdfChannel c, float r) {
+    if (c.transports == 0.0) return 0.0;
+    float s = c.dipole_sigma_tr;
+    float dr = sqrt(r * r + c.zr * c.zr);
+    float dv = sqrt(r * r + c.zv * c.zv);
+    float real_term = c.zr * (1.0 + s * dr) * exp(-s * dr) / (dr * dr * dr);
+    float virtual_term = c.zv * (1.0 + s * dv) * exp(-s * dv) / (dv * dv * dv);
+    return c.dipole_scale * (real_term + virtual_term) * (1.0 / 3.14159265358979323846);
+}
+
+// The ray-source term S'(x, w, r) of the directional dipole.
+float dirpole_source(BssrdfChannel c, vec3 x, vec3 w, float r, vec3 no) {
+    float s_r = c.sigma_tr * r;
+    float one = 1.0 + s_r;
+    float x_dot_w = dot(x, w);
+    float phi = c.c_phi * (r * r / c.d + 3.0 * one * x_dot_w);
+    float e = c.c_e * (3.0 * c.d * one * dot(w, no)
+                       - (one + 3.0 * c.d * (3.0 * one + s_r * s_r) / (r * r) * x_dot_w) * dot(x, no));
+    return c.n_over_4pi2 * exp(-s_r) / (r * r * r) * (phi - e);
+}
+
+// Light refracted into the medium: w12 = -(1/eta)(wi - (wi.ni)ni) - ni sqrt(1 - (1/eta)^2 (1 - (wi.ni)^2)).
+vec3 refract_in(vec3 wi, vec3 ni, float eta) {
+    float cos_i = dot(wi, ni);
+    float k = max(1.0 - (1.0 - cos_i * cos_i) / (eta * eta), 0.0);
+    return -(wi - cos_i * ni) / eta - ni * sqrt(k);
+}
+
+// Real and virtual source terms; Sd = max(0, real - virtual).
+void dirpole_terms(BssrdfChannel c, vec3 xi, vec3 ni, vec3 wi, vec3 xo, vec3 no,
+                   out float real_term, out float virtual_term) {
+    real_term = 0.0;
+    virtual_term = 0.0;
+    if (c.transports == 0.0) return;
+    vec3 x = xo - xi;
+    float r2 = dot(x, x);
+    vec3 w12 = refract_in(wi, ni, c.eta);
+
+    // Modified tangent plane: the part of ni normal to x; ni where x is zero or parallel to ni.
+    vec3 perp = ni - x * (dot(x, ni) / max(r2, 1e-30));
+    vec3 ni_star = (r2 > 0.0 && dot(perp, perp) > 1e-12) ? normalize(perp) : ni;
+
+    float mu0 = -dot(no, w12);
+    float dr2;
+    if (mu0 > 0.0) {
+        float along = dot(x, w12);
+        float cos_beta = -sqrt(max(r2 - along * along, 0.0) / (r2 + c.de * c.de));
+        dr2 = r2 + c.d * mu0 * (c.d * mu0 - 2.0 * c.de * cos_beta);
+    } else {
+        dr2 = r2 + c.back_lit_dr2;
+    }
+    float dr = sqrt(max(dr2, 1e-24 * c.d * c.d));
+
+    vec3 xv = xi + (2.0 * c.a_dirpole * c.de) * ni_star;
+    vec3 wv = w12 - 2.0 * dot(w12, ni_star) * ni_star;
+    vec3 xov = xo - xv;
+    float dv = length(xov);
+
+    real_term = dirpole_source(c, x, w12, dr, no);
+    virtual_term = dirpole_source(c, xov, wv, dv, no);
+}
+
+float dirpole_sd(BssrdfChannel c, vec3 xi, vec3 ni, vec3 wi, vec3 xo, vec3 no) {
+    float real_term, virtual_term;
+    dirpole_terms(c, xi, ni, wi, xo, no, real_term, virtual_term);
+    float v = real_term - virtual_term;
+    // Also maps NaN to 0: a comparison with NaN is false.
+    return (v > 0.0 && v < 3.4e38) ? v : 0.0;
+}
+
+#endif
