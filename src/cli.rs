@@ -7,8 +7,10 @@ use glam::Vec3;
 
 use crate::error::Result;
 use crate::frame::Renderer;
+use crate::materials::Material;
 use crate::mesh::Mesh;
 use crate::output::{self, Exposure};
+use crate::physics::{Diffusion, Model};
 use crate::scene::{Camera, Light, Scene};
 use crate::vk::{self, Context, ContextOptions};
 use crate::{bad_input, runtime};
@@ -26,6 +28,122 @@ pub enum Command {
     Render(Box<RenderArgs>),
     /// List the Vulkan devices with their type, driver, API version and timestamp support.
     Devices,
+    /// List the material presets with their coefficients and derived quantities per channel.
+    Materials,
+    /// Evaluate Sd for CSV rows on stdin (header: sigma_a,sigma_s,g,eta,xi_x,…,no_z), to stdout.
+    Bssrdf(BssrdfArgs),
+    /// Plot Sd against distance per RGB channel for a material (PNG, SVG or CSV).
+    Profile(ProfileArgs),
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ModelArg {
+    Directional,
+    Dipole,
+}
+
+impl From<ModelArg> for Model {
+    fn from(m: ModelArg) -> Model {
+        match m {
+            ModelArg::Directional => Model::Directional,
+            ModelArg::Dipole => Model::Dipole,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum DiffusionArg {
+    /// D = 1/(3σ't), as in the authors' program.
+    Classical,
+    /// D = (2σa + σ's)/(3σ't²).
+    Alternative,
+}
+
+impl From<DiffusionArg> for Diffusion {
+    fn from(d: DiffusionArg) -> Diffusion {
+        match d {
+            DiffusionArg::Classical => Diffusion::Classical,
+            DiffusionArg::Alternative => Diffusion::Alternative,
+        }
+    }
+}
+
+#[derive(Args, Debug)]
+pub struct BssrdfArgs {
+    #[arg(long, value_enum, default_value = "directional")]
+    pub model: ModelArg,
+    #[arg(long, value_enum, default_value = "classical")]
+    pub diffusion: DiffusionArg,
+    /// Evaluate in a compute shader through the GLSL include instead of the Rust code.
+    #[arg(long)]
+    pub gpu: bool,
+    #[command(flatten)]
+    pub device: DeviceArgs,
+}
+
+/// A material: a preset, with any coefficient overridden (per mm; R,G,B or one value).
+#[derive(Args, Debug, Clone)]
+pub struct MaterialArgs {
+    /// Preset name (case-insensitive; `translucent materials` lists them).
+    #[arg(long, default_value = "marble")]
+    pub material: String,
+    /// Absorption coefficient σa [1/mm], one value or R,G,B.
+    #[arg(long, allow_hyphen_values = true, value_parser = triple, value_name = "V|R,G,B")]
+    pub sigma_a: Option<[f64; 3]>,
+    /// Scattering coefficient σs [1/mm], one value or R,G,B.
+    #[arg(long, allow_hyphen_values = true, value_parser = triple, value_name = "V|R,G,B")]
+    pub sigma_s: Option<[f64; 3]>,
+    /// Mean scattering cosine g, one value or R,G,B.
+    #[arg(long, allow_hyphen_values = true, value_parser = triple, value_name = "V|R,G,B")]
+    pub g: Option<[f64; 3]>,
+    /// Relative index of refraction η (inside/outside).
+    #[arg(long, allow_hyphen_values = true, value_parser = any_f64)]
+    pub eta: Option<f64>,
+}
+
+impl MaterialArgs {
+    pub fn material(&self) -> Result<Material> {
+        let mut m = Material::find(&self.material)?;
+        let custom = self.sigma_a.is_some() || self.sigma_s.is_some() || self.g.is_some() || self.eta.is_some();
+        m.sigma_a = self.sigma_a.unwrap_or(m.sigma_a);
+        m.sigma_s = self.sigma_s.unwrap_or(m.sigma_s);
+        m.g = self.g.unwrap_or(m.g);
+        m.eta = self.eta.unwrap_or(m.eta);
+        if custom {
+            m.name = format!("{} (modified)", m.name);
+        }
+        m.validate()?;
+        if let Some(w) = m.warning() {
+            eprintln!("warning: {w}");
+        }
+        Ok(m)
+    }
+}
+
+#[derive(Args, Debug)]
+pub struct ProfileArgs {
+    #[command(flatten)]
+    pub material: MaterialArgs,
+    /// Models to plot.
+    #[arg(long, value_enum, value_delimiter = ',', default_values = ["directional", "dipole"])]
+    pub model: Vec<ModelArg>,
+    /// Angles of incidence in degrees, from the normal.
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true, default_values = ["0", "60"])]
+    pub angles: Vec<f64>,
+    /// Shortest distance plotted [mm].
+    #[arg(long, allow_hyphen_values = true, default_value_t = 0.01)]
+    pub r_min: f64,
+    /// Longest distance plotted [mm] (default: 10 diffusion lengths of the most absorbing channel, at most 1000).
+    #[arg(long, allow_hyphen_values = true)]
+    pub r_max: Option<f64>,
+    #[arg(long, value_enum, default_value = "classical")]
+    pub diffusion: DiffusionArg,
+    /// Points per curve.
+    #[arg(long, default_value_t = 200)]
+    pub samples: usize,
+    /// Output: .png, .svg or .csv.
+    #[arg(long, short, default_value = "profile.png")]
+    pub out: PathBuf,
 }
 
 /// Options shared by every command that creates a Vulkan device.
@@ -95,6 +213,20 @@ pub struct RenderArgs {
     pub device: DeviceArgs,
 }
 
+fn any_f64(s: &str) -> std::result::Result<f64, String> {
+    // Non-finite values parse here and are refused by Material::validate, which names them.
+    s.trim().parse().map_err(|_| format!("'{s}' is not a number"))
+}
+
+fn triple(s: &str) -> std::result::Result<[f64; 3], String> {
+    let v: Vec<f64> = s.split(',').map(any_f64).collect::<std::result::Result<_, _>>()?;
+    match v.as_slice() {
+        [x] => Ok([*x; 3]),
+        [r, g, b] => Ok([*r, *g, *b]),
+        _ => Err(format!("'{s}' is neither one number nor R,G,B")),
+    }
+}
+
 fn finite_f32(s: &str) -> std::result::Result<f32, String> {
     let v: f32 = s.trim().parse().map_err(|_| format!("'{s}' is not a number"))?;
     if !v.is_finite() {
@@ -139,7 +271,67 @@ pub fn run(cli: Cli) -> Result<i32> {
     match cli.command {
         Command::Render(args) => render(&args),
         Command::Devices => devices(),
+        Command::Materials => {
+            print!("{}", crate::materials::materials_table());
+            Ok(0)
+        }
+        Command::Bssrdf(args) => bssrdf(&args),
+        Command::Profile(args) => profile(&args),
     }
+}
+
+fn bssrdf(args: &BssrdfArgs) -> Result<i32> {
+    let stdin = std::io::stdin();
+    let queries = crate::bssrdf_csv::parse(stdin.lock())?;
+    let (model, diffusion) = (Model::from(args.model), Diffusion::from(args.diffusion));
+    let start = std::time::Instant::now();
+    let (sd, code) = if args.gpu {
+        let ctx = Context::new(&args.device.options())?;
+        let counts = ctx.validation_counts();
+        let validating = ctx.validation;
+        let pass = crate::passes::bssrdf_eval::BssrdfEvalPass::new(&ctx)?;
+        let sd: Vec<f64> = pass.evaluate(&ctx, &queries, model, diffusion)?.into_iter().map(f64::from).collect();
+        drop(pass);
+        drop(ctx);
+        (sd, validation_exit_code(validating, &counts))
+    } else {
+        (queries.iter().map(|q| q.sd(model, diffusion)).collect(), 0)
+    };
+    log::info!("evaluated {} rows in {:.3} s", queries.len(), start.elapsed().as_secs_f64());
+    crate::bssrdf_csv::write(std::io::stdout().lock(), &queries, &sd)?;
+    Ok(code)
+}
+
+fn profile(args: &ProfileArgs) -> Result<i32> {
+    let material = args.material.material()?;
+    let r_max = match args.r_max {
+        Some(r) => r,
+        None => {
+            // Ten diffusion lengths 1/σtr of the channel that dies out first.
+            let sigma_tr = (0..3)
+                .map(|ch| material.channel(ch).constants(Diffusion::from(args.diffusion)))
+                .filter(|c| c.transports)
+                .map(|c| c.sigma_tr)
+                .fold(0.0f64, f64::max);
+            if sigma_tr > 0.0 {
+                (10.0 / sigma_tr).min(1000.0)
+            } else {
+                100.0
+            }
+        }
+    };
+    let spec = crate::plot::ProfileSpec {
+        material,
+        models: args.model.iter().map(|&m| m.into()).collect(),
+        angles_deg: args.angles.clone(),
+        r_min_mm: args.r_min,
+        r_max_mm: r_max,
+        diffusion: args.diffusion.into(),
+        samples: args.samples,
+    };
+    crate::plot::write_profile(&spec, &args.out)?;
+    eprintln!("wrote {}", args.out.display());
+    Ok(0)
 }
 
 fn devices() -> Result<i32> {

@@ -10,6 +10,7 @@ pub mod mesh;
 pub mod output;
 pub mod passes;
 pub mod physics;
+pub mod plot;
 pub mod profiling;
 pub mod scene;
 pub mod shaders;
