@@ -33,7 +33,7 @@ pub enum Command {
     /// Evaluate Sd for CSV rows on stdin (header: sigma_a,sigma_s,g,eta,xi_x,…,no_z), to stdout.
     Bssrdf(BssrdfArgs),
     /// Plot Sd against distance per RGB channel for a material (PNG, SVG or CSV).
-    Profile(ProfileArgs),
+    Profile(Box<ProfileArgs>),
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
