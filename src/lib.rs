@@ -5,6 +5,7 @@ pub mod bssrdf_csv;
 pub mod cli;
 pub mod error;
 pub mod frame;
+pub mod hierarchy;
 pub mod materials;
 pub mod mesh;
 pub mod output;

@@ -302,3 +302,35 @@ fn truncate(s: &str) -> String {
         s.to_string()
     }
 }
+
+impl Mesh {
+    /// Whether `p` is inside the closed mesh: parity of the crossings of a ray from `p`
+    /// (Möller–Trumbore; an irrational-ish direction avoids edges and vertices of regular meshes).
+    pub fn contains_point(&self, p: Vec3) -> bool {
+        let dir = Vec3::new(0.5773, 0.5774, 0.5772).normalize();
+        let mut crossings = 0;
+        for t in self.indices.chunks_exact(3) {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| self.positions[i as usize]);
+            let (e1, e2) = (b - a, c - a);
+            let h = dir.cross(e2);
+            let det = e1.dot(h);
+            if det.abs() < 1e-12 {
+                continue;
+            }
+            let s = p - a;
+            let u = s.dot(h) / det;
+            if !(0.0..=1.0).contains(&u) {
+                continue;
+            }
+            let q = s.cross(e1);
+            let v = dir.dot(q) / det;
+            if v < 0.0 || u + v > 1.0 {
+                continue;
+            }
+            if e2.dot(q) / det > 0.0 {
+                crossings += 1;
+            }
+        }
+        crossings % 2 == 1
+    }
+}

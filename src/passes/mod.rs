@@ -1,4 +1,9 @@
 //! GPU passes: each is one shader (or a few stages of one) plus one file here.
 
 pub mod bssrdf_eval;
+pub mod irradiance;
+pub mod sampling;
 pub mod shade;
+pub mod shadow;
+pub mod sort;
+pub mod tree;

@@ -388,13 +388,14 @@ impl<'a> Recorder<'a> {
         layer: u32,
     ) -> Result<()> {
         for (img, clear) in colors {
-            if clear.is_some() {
+            if clear.is_some() && img.layers == 1 {
                 self.discard_image(img);
             }
             self.use_image(img, Access::COLOR_ATTACHMENT)?;
         }
         if let Some((img, clear)) = depth {
-            if clear.is_some() {
+            // A layout transition from UNDEFINED would discard every layer, not just this one.
+            if clear.is_some() && img.layers == 1 {
                 self.discard_image(img);
             }
             self.use_image(img, Access::DEPTH_ATTACHMENT)?;
@@ -404,10 +405,12 @@ impl<'a> Recorder<'a> {
             if img.layers == 1 {
                 Ok(img.view)
             } else {
-                Err(runtime!("{}: rendering into one layer of an array image needs a per-layer view", img.name))
+                img.layer_views
+                    .get(layer as usize)
+                    .copied()
+                    .ok_or_else(|| runtime!("{}: no layer {layer} ({} layers)", img.name, img.layers))
             }
         };
-        let _ = layer;
         let color_infos: Vec<_> = colors
             .iter()
             .map(|(img, clear)| {

@@ -431,6 +431,10 @@ impl Context {
             // Optimised SPIR-V 1.6 declares work-group sizes with LocalSizeId, which needs it.
             missing.push("maintenance4");
         }
+        if have12.vulkan_memory_model == vk::FALSE || have12.vulkan_memory_model_device_scope == vk::FALSE {
+            // The tree's bottom-up pass hands data between invocations with acquire/release atomics.
+            missing.push("vulkanMemoryModel");
+        }
         if have12.host_query_reset == vk::FALSE {
             missing.push("hostQueryReset");
         }
@@ -443,7 +447,10 @@ impl Context {
         let has_shader_int64 = have10.shader_int64 == vk::TRUE;
 
         let features10 = vk::PhysicalDeviceFeatures::default().shader_int64(has_shader_int64);
-        let mut features12 = vk::PhysicalDeviceVulkan12Features::default().host_query_reset(true);
+        let mut features12 = vk::PhysicalDeviceVulkan12Features::default()
+            .host_query_reset(true)
+            .vulkan_memory_model(true)
+            .vulkan_memory_model_device_scope(true);
         let mut features13 = vk::PhysicalDeviceVulkan13Features::default()
             .dynamic_rendering(true)
             .synchronization2(true)

@@ -40,3 +40,20 @@ pub fn upload_buffer<T: bytemuck::Pod>(
     ctx.submit(None, |rec| rec.copy_buffer(&staging, &buffer, bytes))?;
     Ok(buffer)
 }
+
+/// Copies `count` elements of a device buffer back to the host (tests, tools; not per frame).
+pub fn download_buffer<T: bytemuck::Pod>(ctx: &Context, buffer: &Buffer, count: usize) -> crate::Result<Vec<T>> {
+    let bytes = (count * std::mem::size_of::<T>()) as u64;
+    let staging = Buffer::new(
+        ctx,
+        &format!("{} (download)", buffer.name),
+        bytes,
+        BufferUsageFlags::TRANSFER_DST,
+        MemoryLocation::GpuToCpu,
+    )?;
+    ctx.submit(None, |rec| {
+        rec.copy_buffer(buffer, &staging, bytes)?;
+        rec.host_read(&staging)
+    })?;
+    staging.read(count)
+}

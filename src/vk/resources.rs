@@ -303,6 +303,8 @@ pub struct Image {
     shared: Arc<Shared>,
     pub(crate) raw: vk::Image,
     pub(crate) view: vk::ImageView,
+    /// One 2D view per layer of an array image, to render into a single layer.
+    pub(crate) layer_views: Vec<vk::ImageView>,
     allocation: Option<Allocation>,
     pub format: vk::Format,
     pub extent: vk::Extent2D,
@@ -382,10 +384,41 @@ impl Image {
                 return Err(runtime!("image {name}: {e}"));
             }
         };
+        let mut layer_views = Vec::new();
+        if layers > 1 {
+            for layer in 0..layers {
+                let info = vk::ImageViewCreateInfo::default()
+                    .image(raw)
+                    .view_type(vk::ImageViewType::TYPE_2D)
+                    .format(format)
+                    .subresource_range(vk::ImageSubresourceRange {
+                        aspect_mask: aspect_of(format),
+                        base_mip_level: 0,
+                        level_count: 1,
+                        base_array_layer: layer,
+                        layer_count: 1,
+                    });
+                match unsafe { device.create_image_view(&info, None) } {
+                    Ok(v) => layer_views.push(v),
+                    Err(e) => {
+                        unsafe {
+                            for v in layer_views {
+                                device.destroy_image_view(v, None);
+                            }
+                            device.destroy_image_view(view, None);
+                            device.destroy_image(raw, None);
+                        }
+                        let _ = ctx.shared.allocator.lock().unwrap().free(allocation);
+                        return Err(runtime!("image {name} layer view: {e}"));
+                    }
+                }
+            }
+        }
         Ok(Image {
             shared: ctx.shared.clone(),
             raw,
             view,
+            layer_views,
             allocation: Some(allocation),
             format,
             extent,
@@ -400,6 +433,9 @@ impl Drop for Image {
     fn drop(&mut self) {
         // SAFETY: every submission is waited for before resources can be dropped.
         unsafe {
+            for v in &self.layer_views {
+                self.shared.device.destroy_image_view(*v, None);
+            }
             self.shared.device.destroy_image_view(self.view, None);
             self.shared.device.destroy_image(self.raw, None);
         }

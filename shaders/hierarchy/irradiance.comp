@@ -1,0 +1,54 @@
+#version 460
+// Irradiance entering each point: sum over lights of I · max(0, n·l) · Ft(eta, n·l) · visibility,
+// and the irradiance-weighted direction toward the lights (the directional dipole's wi).
+#include "points.glsl"
+#include "bssrdf.glsl"
+#include "lights.glsl"
+layout(local_size_x = 64) in;
+layout(std430, binding = 0) buffer Points { SurfacePoint points[]; };
+layout(std430, binding = 1) readonly buffer Lights { LightSet light_set; mat4 layer_matrices[]; };
+layout(binding = 2) uniform sampler2DArrayShadow shadow_map;
+layout(push_constant) uniform IrradianceConstants { uint point_count; } pc;
+
+// Cube face of a direction from a point light: +x, -x, +y, -y, +z, -z (as in src/passes/shadow.rs).
+uint cube_face(vec3 d) {
+    vec3 a = abs(d);
+    if (a.x >= a.y && a.x >= a.z) return d.x >= 0.0 ? 0u : 1u;
+    if (a.y >= a.z) return d.y >= 0.0 ? 2u : 3u;
+    return d.z >= 0.0 ? 4u : 5u;
+}
+
+void main() {
+    uint i = gl_GlobalInvocationID.x;
+    if (i >= pc.point_count) return;
+    SurfacePoint p = points[i];
+    vec3 irradiance = vec3(0.0);
+    vec3 weighted_dir = vec3(0.0);
+    for (uint k = 0u; k < light_set.light_count; ++k) {
+        GpuLight light = light_set.lights[k];
+        vec3 toward;
+        vec3 incident;
+        uint layer = light.first_layer;
+        if (light.position.w == 0.0) {
+            toward = normalize(light.position.xyz);
+            incident = light.intensity.rgb;
+        } else {
+            vec3 d = light.position.xyz - p.position;
+            float d2 = max(dot(d, d), 1e-20);
+            toward = d * inversesqrt(d2);
+            incident = light.intensity.rgb / d2;
+            layer += cube_face(-d);
+        }
+        float cos_theta = dot(p.normal, toward);
+        if (cos_theta <= 0.0) continue;
+        // Offset along the normal by a few shadow-map texels so lit surfaces do not shadow themselves.
+        vec4 clip = layer_matrices[layer] * vec4(p.position + p.normal * light_set.normal_offset, 1.0);
+        vec3 ndc = clip.xyz / clip.w;
+        float visibility = texture(shadow_map, vec4(ndc.xy * 0.5 + 0.5, float(layer), ndc.z));
+        vec3 e = incident * cos_theta * fresnel_transmittance(light_set.eta, cos_theta) * visibility;
+        irradiance += e;
+        weighted_dir += dot(e, vec3(0.2126, 0.7152, 0.0722)) * toward;
+    }
+    points[i].irradiance = irradiance;
+    points[i].light_dir = dot(weighted_dir, weighted_dir) > 0.0 ? normalize(weighted_dir) : vec3(0.0);
+}

@@ -1,0 +1,74 @@
+// Surface samples and the Jensen–Buhler tree nodes. Mirrored by SurfacePoint and TreeNode in
+// src/hierarchy.rs; a test compares the SPIR-V member offsets with the Rust structs.
+#ifndef POINTS_GLSL
+#define POINTS_GLSL
+
+// One irradiance sample on the surface (64 bytes).
+struct SurfacePoint {
+    vec3 position;
+    float area;        // total area / N
+    vec3 normal;
+    uint triangle;     // the triangle it was sampled on
+    vec3 irradiance;   // W/m² per RGB entering the surface: I cos Ft(eta) visibility, summed over lights
+    float pad0;
+    vec3 light_dir;    // irradiance-weighted mean direction toward the lights (unit, or 0 if unlit)
+    float pad1;
+};
+
+// A node of the Karras (HPG 2012) binary radix tree over the Morton-sorted points (64 bytes).
+// Children with LEAF_BIT set are point indices (in sorted order), else node indices.
+const uint LEAF_BIT = 0x80000000u;
+struct TreeNode {
+    vec3 power;        // sum of irradiance × area per RGB
+    float area;        // sum of point areas
+    vec3 power_center;     // power-weighted mean position (area-weighted where the power is 0)
+    uint left;
+    uvec3 box_half;    // bounding box as 6 halfs, rounded outward: min.xy | min.z max.x | max.yz
+    uint right;
+    uint normal_oct;   // area-weighted mean normal, octahedral 2×16-bit snorm
+    uint light_oct;    // power-weighted mean light direction, octahedral 2×16-bit snorm
+    uint first_point;  // the node's points are sorted points [first_point, first_point + point_count)
+    uint point_count;
+};
+
+// Octahedral encoding of a unit vector (Cigolle et al. 2014) into 2×16-bit snorm.
+vec2 oct_wrap(vec2 v) {
+    return (1.0 - abs(v.yx)) * vec2(v.x >= 0.0 ? 1.0 : -1.0, v.y >= 0.0 ? 1.0 : -1.0);
+}
+uint encode_oct(vec3 n) {
+    float l1 = abs(n.x) + abs(n.y) + abs(n.z);
+    if (l1 == 0.0) return packSnorm2x16(vec2(0.0)) ; // zero vector: decodes to (0,0,1)
+    vec2 p = n.xy / l1;
+    if (n.z < 0.0) p = oct_wrap(p);
+    return packSnorm2x16(p);
+}
+vec3 decode_oct(uint e) {
+    vec2 p = unpackSnorm2x16(e);
+    vec3 n = vec3(p, 1.0 - abs(p.x) - abs(p.y));
+    if (n.z < 0.0) n.xy = oct_wrap(n.xy);
+    return normalize(n);
+}
+
+// Half-float bounds rounded outward, so the stored box always contains the exact one.
+uint half_bits(float x) { return packHalf2x16(vec2(x, 0.0)) & 0xffffu; }
+float half_value(uint h) { return unpackHalf2x16(h).x; }
+uint half_down(float x) {
+    uint h = half_bits(x);
+    if (half_value(h) > x) h = (x > 0.0) ? h - 1u : ((h & 0x7fffu) == 0u ? 0x8001u : h + 1u);
+    return h;
+}
+uint half_up(float x) {
+    uint h = half_bits(x);
+    if (half_value(h) < x) h = (x >= 0.0) ? ((h & 0x7fffu) == 0u ? 1u : h + 1u) : h - 1u;
+    return h;
+}
+uvec3 pack_box(vec3 lo, vec3 hi) {
+    return uvec3(half_down(lo.x) | (half_down(lo.y) << 16),
+                 half_down(lo.z) | (half_up(hi.x) << 16),
+                 half_up(hi.y) | (half_up(hi.z) << 16));
+}
+void unpack_box(uvec3 b, out vec3 lo, out vec3 hi) {
+    lo = vec3(half_value(b.x & 0xffffu), half_value(b.x >> 16), half_value(b.y & 0xffffu));
+    hi = vec3(half_value(b.y >> 16), half_value(b.z & 0xffffu), half_value(b.z >> 16));
+}
+#endif

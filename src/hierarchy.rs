@@ -1,0 +1,484 @@
+//! The Jensen–Buhler hierarchy, rebuilt on the GPU every frame: sample points over the mesh,
+//! their irradiance (shadow maps + Fresnel), Morton sort, and a tree whose nodes summarise them.
+//!
+//! Why a Karras binary radix tree and not an octree: it is built from the sorted keys alone with
+//! one thread per node and no atomics (octree builds need per-level passes and compaction), every
+//! node has exactly two children (no empty nodes to skip), and each node's points are one
+//! contiguous range of the sorted array. Leaves are single points; the shading pass can stop
+//! descending at small ranges and loop over the points directly.
+
+use bytemuck::{Pod, Zeroable};
+use glam::{DVec3, Mat4, Vec3};
+
+use crate::error::Result;
+use crate::mesh::Mesh;
+use crate::passes::irradiance::{GpuLight, IrradiancePass, LightSetHeader, MAX_LIGHTS};
+use crate::passes::sampling::SamplingPass;
+use crate::passes::shadow::{self, ShadowPass};
+use crate::passes::sort::{SortBuffers, SortPass, TILE};
+use crate::passes::tree::{TreeBuffers, TreePass};
+use crate::scene::Light;
+use crate::vk::{
+    self, Buffer, BufferUsageFlags, Context, Extent2D, Image, ImageUsageFlags, MemoryLocation, Recorder, Sampler,
+};
+use crate::{bad_input, runtime};
+
+/// Mirrors `SurfacePoint` in shaders/include/points.glsl (64 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct SurfacePoint {
+    pub position: Vec3,
+    pub area: f32,
+    pub normal: Vec3,
+    pub triangle: u32,
+    pub irradiance: Vec3,
+    pub pad0: f32,
+    pub light_dir: Vec3,
+    pub pad1: f32,
+}
+
+/// Set in a child index when the child is a point (index into the sorted points).
+pub const LEAF_BIT: u32 = 0x8000_0000;
+
+/// Mirrors `TreeNode` in shaders/include/points.glsl (64 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct TreeNode {
+    pub power: Vec3,
+    pub area: f32,
+    pub power_center: Vec3,
+    pub left: u32,
+    pub box_half: [u32; 3],
+    pub right: u32,
+    pub normal_oct: u32,
+    pub light_oct: u32,
+    pub first_point: u32,
+    pub point_count: u32,
+}
+
+impl TreeNode {
+    /// The bounding box (min, max) from its half floats.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        let h = |bits: u32| half_to_f32(bits as u16);
+        let b = self.box_half;
+        (
+            Vec3::new(h(b[0] & 0xffff), h(b[0] >> 16), h(b[1] & 0xffff)),
+            Vec3::new(h(b[1] >> 16), h(b[2] & 0xffff), h(b[2] >> 16)),
+        )
+    }
+    pub fn normal(&self) -> Vec3 {
+        decode_oct(self.normal_oct)
+    }
+    pub fn light_dir(&self) -> Vec3 {
+        if self.light_oct == 0 {
+            Vec3::ZERO
+        } else {
+            decode_oct(self.light_oct)
+        }
+    }
+}
+
+/// IEEE half to f32.
+pub fn half_to_f32(h: u16) -> f32 {
+    let sign = if h & 0x8000 != 0 { -1.0 } else { 1.0 };
+    let exponent = ((h >> 10) & 0x1f) as i32;
+    let mantissa = (h & 0x3ff) as f32;
+    sign * match exponent {
+        0 => mantissa * 2f32.powi(-24),
+        31 => f32::INFINITY,
+        e => (1.0 + mantissa / 1024.0) * 2f32.powi(e - 15),
+    }
+}
+
+/// Octahedral decoding of 2×16-bit snorm (as GLSL's unpackSnorm2x16).
+pub fn decode_oct(e: u32) -> Vec3 {
+    let s = |v: u16| (v as i16 as f32 / 32767.0).clamp(-1.0, 1.0);
+    let (x, y) = (s(e as u16), s((e >> 16) as u16));
+    let mut n = Vec3::new(x, y, 1.0 - x.abs() - y.abs());
+    if n.z < 0.0 {
+        let (ox, oy) = (n.x, n.y);
+        n.x = (1.0 - oy.abs()) * if ox >= 0.0 { 1.0 } else { -1.0 };
+        n.y = (1.0 - ox.abs()) * if oy >= 0.0 { 1.0 } else { -1.0 };
+    }
+    n.normalize()
+}
+
+/// Bytes on the GPU per sample point: the point twice (unsorted, sorted), two keys, two values,
+/// a point parent and about one node (with its parent and arrival counter).
+const BYTES_PER_POINT: u64 = 64 * 2 + 8 * 2 + 4 * 2 + 4 + 64 + 4 + 4 + 4;
+
+/// The largest sample count the device can hold: each buffer within `maxStorageBufferRange`.
+pub fn max_points(ctx: &Context) -> u32 {
+    let range = ctx.limits().max_storage_buffer_range as u64;
+    // The largest per-point buffers (points, nodes) are 64 bytes per element; the radix count
+    // table is 256 counters per tile of 256 keys, about 4 bytes per key.
+    (range / 64).min(u32::MAX as u64 / 2) as u32
+}
+
+/// Checks a requested sample count against the device.
+pub fn check_point_count(ctx: &Context, n: u32) -> Result<()> {
+    let max = max_points(ctx);
+    if n < 2 {
+        return Err(bad_input!("--samples {n}: at least 2 sample points are needed"));
+    }
+    if n > max {
+        return Err(bad_input!(
+            "--samples {n}: more than this device can hold ({max}: {} MiB per storage buffer, 64 bytes per point and node)",
+            ctx.limits().max_storage_buffer_range >> 20
+        ));
+    }
+    Ok(())
+}
+
+/// Memory the hierarchy uses on the GPU for `n` points, in bytes.
+pub fn bytes_used(n: u32) -> u64 {
+    n as u64 * BYTES_PER_POINT
+}
+
+pub struct Hierarchy {
+    sampling: SamplingPass,
+    shadow: ShadowPass,
+    irradiance: IrradiancePass,
+    sort: SortPass,
+    tree: TreePass,
+    prefix: Buffer,
+    points: Buffer,
+    keys: [Buffer; 2],
+    values: [Buffer; 2],
+    counts: Buffer,
+    pub sorted_points: Buffer,
+    pub nodes: Buffer,
+    pub node_parent: Buffer,
+    pub point_parent: Buffer,
+    pub arrivals: Buffer,
+    lights: Buffer,
+    shadow_map: Image,
+    shadow_sampler: Sampler,
+    layer_matrices: Vec<Mat4>,
+    pub point_count: u32,
+    triangle_count: u32,
+    index_count: u32,
+    bounds: (Vec3, Vec3),
+    pub seed: u32,
+}
+
+pub struct HierarchyOptions {
+    pub point_count: u32,
+    pub shadow_resolution: u32,
+    pub eta: f32,
+}
+
+impl Hierarchy {
+    pub fn new(ctx: &Context, mesh: &Mesh, lights: &[Light], options: &HierarchyOptions) -> Result<Hierarchy> {
+        let n = options.point_count;
+        check_point_count(ctx, n)?;
+        if lights.is_empty() || lights.len() > MAX_LIGHTS {
+            return Err(bad_input!("between 1 and {MAX_LIGHTS} lights are supported, {} given", lights.len()));
+        }
+        let storage = |name: &str, bytes: u64| {
+            Buffer::new(
+                ctx,
+                name,
+                bytes,
+                BufferUsageFlags::STORAGE_BUFFER | BufferUsageFlags::TRANSFER_SRC | BufferUsageFlags::TRANSFER_DST,
+                MemoryLocation::GpuOnly,
+            )
+        };
+        let n64 = n as u64;
+        let tiles = n.div_ceil(TILE) as u64;
+        let layers: u32 = lights.iter().map(|l| if matches!(l, Light::Point { .. }) { 6 } else { 1 }).sum();
+        let res = options.shadow_resolution;
+        let (lo, hi) = mesh.bounds();
+        let pad = (hi - lo).max_element() * 1e-3;
+        let mut h = Hierarchy {
+            sampling: SamplingPass::new(ctx)?,
+            shadow: ShadowPass::new(ctx)?,
+            irradiance: IrradiancePass::new(ctx)?,
+            sort: SortPass::new(ctx)?,
+            tree: TreePass::new(ctx)?,
+            prefix: storage("triangle area prefix sum", (mesh.triangle_count() as u64 + 1) * 4)?,
+            points: storage("points", n64 * 64)?,
+            keys: [storage("morton keys A", n64 * 8)?, storage("morton keys B", n64 * 8)?],
+            values: [storage("sort order A", n64 * 4)?, storage("sort order B", n64 * 4)?],
+            counts: storage("radix counts", tiles * 256 * 4)?,
+            sorted_points: storage("sorted points", n64 * 64)?,
+            nodes: storage("tree nodes", (n64 - 1) * 64)?,
+            node_parent: storage("node parents", (n64 - 1) * 4)?,
+            point_parent: storage("point parents", n64 * 4)?,
+            arrivals: storage("node arrival counters", (n64 - 1) * 4)?,
+            lights: Buffer::new(
+                ctx,
+                "lights",
+                (std::mem::size_of::<LightSetHeader>() + 64 * layers as usize) as u64,
+                BufferUsageFlags::STORAGE_BUFFER,
+                MemoryLocation::CpuToGpu,
+            )?,
+            shadow_map: Image::new_2d(
+                ctx,
+                "shadow map",
+                shadow::SHADOW_FORMAT,
+                Extent2D { width: res, height: res },
+                layers.max(2), // an array view even for one light (sampler2DArrayShadow)
+                ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | ImageUsageFlags::SAMPLED,
+            )?,
+            shadow_sampler: Sampler::new(ctx, true, true)?,
+            layer_matrices: Vec::new(),
+            point_count: n,
+            triangle_count: mesh.triangle_count() as u32,
+            index_count: mesh.indices.len() as u32,
+            bounds: (lo - Vec3::splat(pad), hi + Vec3::splat(pad)),
+            seed: 0x9e37_79b9,
+        };
+        h.set_lights(mesh, lights, options.eta, res)?;
+        Ok(h)
+    }
+
+    /// Writes the lights and their shadow matrices (call when lights change, e.g. every frame).
+    pub fn set_lights(&mut self, mesh: &Mesh, lights: &[Light], eta: f32, resolution: u32) -> Result<()> {
+        let (centre, radius) = crate::scene::bounding_sphere(&mesh.positions);
+        let radius = radius.max(1e-6) * 1.01;
+        let mut header = LightSetHeader {
+            light_count: lights.len() as u32,
+            eta,
+            // Two shadow-map texels of the orthographic maps.
+            normal_offset: 2.0 * 2.0 * radius / resolution as f32,
+            pad: 0.0,
+            lights: [GpuLight::default(); MAX_LIGHTS],
+        };
+        self.layer_matrices.clear();
+        for (k, light) in lights.iter().enumerate() {
+            light.validate()?;
+            if let Light::Point { position, .. } = light {
+                if mesh.contains_point(*position) {
+                    return Err(bad_input!("point light at {position} is inside the mesh: it would light nothing"));
+                }
+            }
+            let (position, intensity) = match *light {
+                Light::Directional { toward, irradiance } => (toward.normalize().extend(0.0), irradiance.extend(0.0)),
+                Light::Point { position, intensity } => (position.extend(1.0), intensity.extend(0.0)),
+            };
+            header.lights[k] =
+                GpuLight { position, intensity, first_layer: self.layer_matrices.len() as u32, pad: [0; 3] };
+            self.layer_matrices.extend(shadow::light_matrices(light, centre, radius));
+        }
+        if self.layer_matrices.len() as u32 > self.shadow_map.layers {
+            return Err(runtime!(
+                "lights need {} shadow layers, {} allocated",
+                self.layer_matrices.len(),
+                self.shadow_map.layers
+            ));
+        }
+        self.lights.write(0, &[header])?;
+        self.lights.write(std::mem::size_of::<LightSetHeader>() as u64, &self.layer_matrices)?;
+        Ok(())
+    }
+
+    /// Records every stage, each in its own timestamp scope.
+    pub fn record(&self, rec: &mut Recorder, vertices: &Buffer, indices: &Buffer) -> Result<()> {
+        let n = self.point_count;
+        rec.begin_scope("sampling");
+        self.sampling.record(rec, vertices, indices, self.triangle_count, &self.prefix, &self.points, n, self.seed)?;
+        rec.end_scope();
+
+        rec.begin_scope("shadow maps");
+        self.shadow.record(rec, vertices, indices, self.index_count, &self.shadow_map, &self.layer_matrices)?;
+        rec.end_scope();
+
+        rec.begin_scope("irradiance");
+        self.irradiance.record(rec, &self.points, n, &self.lights, &self.shadow_map, &self.shadow_sampler)?;
+        rec.end_scope();
+
+        let sort_buffers = SortBuffers {
+            points: &self.points,
+            keys: [&self.keys[0], &self.keys[1]],
+            values: [&self.values[0], &self.values[1]],
+            counts: &self.counts,
+            sorted_points: &self.sorted_points,
+        };
+        rec.begin_scope("morton codes");
+        self.sort.record_morton(rec, &sort_buffers, n, self.bounds)?;
+        rec.end_scope();
+        rec.begin_scope("radix sort");
+        self.sort.record_sort(rec, &sort_buffers, n)?;
+        rec.end_scope();
+
+        let tree_buffers = TreeBuffers {
+            keys: &self.keys[0],
+            sorted_points: &self.sorted_points,
+            nodes: &self.nodes,
+            node_parent: &self.node_parent,
+            point_parent: &self.point_parent,
+            arrivals: &self.arrivals,
+        };
+        rec.begin_scope("tree build");
+        self.tree.record_build(rec, &tree_buffers, n)?;
+        rec.end_scope();
+        rec.begin_scope("tree summaries");
+        self.tree.record_aggregate(rec, &tree_buffers, n)?;
+        rec.end_scope();
+        Ok(())
+    }
+
+    /// Unsorted points, sorted keys, sort order, sorted points and nodes, for tests and tools.
+    pub fn download(&self, ctx: &Context) -> Result<Snapshot> {
+        let n = self.point_count as usize;
+        Ok(Snapshot {
+            points: vk::download_buffer(ctx, &self.points, n)?,
+            keys: vk::download_buffer(ctx, &self.keys[0], n)?,
+            order: vk::download_buffer(ctx, &self.values[0], n)?,
+            sorted_points: vk::download_buffer(ctx, &self.sorted_points, n)?,
+            nodes: vk::download_buffer(ctx, &self.nodes, n - 1)?,
+        })
+    }
+
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        self.bounds
+    }
+}
+
+pub struct Snapshot {
+    pub points: Vec<SurfacePoint>,
+    pub keys: Vec<[u32; 2]>,
+    pub order: Vec<u32>,
+    pub sorted_points: Vec<SurfacePoint>,
+    pub nodes: Vec<TreeNode>,
+}
+
+/// A node built on the CPU in f64, for checking the GPU's.
+#[derive(Clone, Debug)]
+pub struct ReferenceNode {
+    pub left: u32,
+    pub right: u32,
+    pub first_point: u32,
+    pub point_count: u32,
+    pub power: DVec3,
+    pub area: f64,
+    pub power_center: DVec3,
+    pub normal: DVec3,
+    /// |Σ child normal × area| / Σ area: near 0 where the normals cancel (the direction is noise).
+    pub normal_coherence: f64,
+    pub light_dir: DVec3,
+    pub light_coherence: f64,
+    pub lo: DVec3,
+    pub hi: DVec3,
+}
+
+/// The same Karras tree built serially from the sorted keys, with f64 summaries.
+pub fn reference_tree(keys: &[[u32; 2]], points: &[SurfacePoint]) -> Vec<ReferenceNode> {
+    let n = keys.len() as i64;
+    let key = |i: i64| ((keys[i as usize][1] as u64) << 32) | keys[i as usize][0] as u64;
+    let delta = |i: i64, j: i64| -> i64 {
+        if j < 0 || j >= n {
+            return -1;
+        }
+        let (a, b) = (key(i), key(j));
+        if a == b {
+            64 + ((i as u32) ^ (j as u32)).leading_zeros() as i64
+        } else {
+            (a ^ b).leading_zeros() as i64
+        }
+    };
+    let mut nodes: Vec<ReferenceNode> = (0..n - 1)
+        .map(|i| {
+            let d = if delta(i, i + 1) - delta(i, i - 1) >= 0 { 1 } else { -1 };
+            let delta_min = delta(i, i - d);
+            let mut l_max = 2;
+            while delta(i, i + l_max * d) > delta_min {
+                l_max *= 2;
+            }
+            let mut l = 0;
+            let mut t = l_max / 2;
+            while t >= 1 {
+                if delta(i, i + (l + t) * d) > delta_min {
+                    l += t;
+                }
+                t /= 2;
+            }
+            let j = i + l * d;
+            let delta_node = delta(i, j);
+            let mut s = 0;
+            let mut t = (l + 1) / 2;
+            loop {
+                if delta(i, i + (s + t) * d) > delta_node {
+                    s += t;
+                }
+                if t == 1 {
+                    break;
+                }
+                t = (t + 1) / 2;
+            }
+            let split = i + s * d + d.min(0);
+            let (first, last) = (i.min(j), i.max(j));
+            let left = if first == split { split as u32 | LEAF_BIT } else { split as u32 };
+            let right = if last == split + 1 { (split + 1) as u32 | LEAF_BIT } else { (split + 1) as u32 };
+            ReferenceNode {
+                left,
+                right,
+                first_point: first as u32,
+                point_count: (last - first + 1) as u32,
+                power: DVec3::ZERO,
+                area: 0.0,
+                power_center: DVec3::ZERO,
+                normal: DVec3::ZERO,
+                normal_coherence: 0.0,
+                light_dir: DVec3::ZERO,
+                light_coherence: 0.0,
+                lo: DVec3::ZERO,
+                hi: DVec3::ZERO,
+            }
+        })
+        .collect();
+    // Summaries, children first: a node's children have larger depth; recurse from the root.
+    fn summarise(
+        k: u32,
+        nodes: &mut Vec<ReferenceNode>,
+        points: &[SurfacePoint],
+    ) -> (DVec3, f64, DVec3, DVec3, DVec3, DVec3, DVec3) {
+        if k & LEAF_BIT != 0 {
+            let p = &points[(k & !LEAF_BIT) as usize];
+            let pos = p.position.as_dvec3();
+            return (
+                (p.irradiance * p.area).as_dvec3(),
+                p.area as f64,
+                pos,
+                p.normal.as_dvec3(),
+                p.light_dir.as_dvec3(),
+                pos,
+                pos,
+            );
+        }
+        let (l, r) = (nodes[k as usize].left, nodes[k as usize].right);
+        let a = summarise(l, nodes, points);
+        let b = summarise(r, nodes, points);
+        let lum = |c: DVec3| c.dot(DVec3::new(0.2126, 0.7152, 0.0722));
+        let (wa, wb) = (lum(a.0), lum(b.0));
+        let centre =
+            if wa + wb > 0.0 { (a.2 * wa + b.2 * wb) / (wa + wb) } else { (a.2 * a.1 + b.2 * b.1) / (a.1 + b.1) };
+        let normal = (a.3 * a.1 + b.3 * b.1).normalize_or(DVec3::Z);
+        let light = (a.4 * wa + b.4 * wb).normalize_or_zero();
+        let node = &mut nodes[k as usize];
+        node.normal_coherence = (a.3 * a.1 + b.3 * b.1).length() / (a.1 + b.1);
+        node.light_coherence = if wa + wb > 0.0 { (a.4 * wa + b.4 * wb).length() / (wa + wb) } else { 0.0 };
+        node.power = a.0 + b.0;
+        node.area = a.1 + b.1;
+        node.power_center = centre;
+        node.normal = normal;
+        node.light_dir = light;
+        node.lo = a.5.min(b.5);
+        node.hi = a.6.max(b.6);
+        (node.power, node.area, centre, normal, light, node.lo, node.hi)
+    }
+    if n >= 2 {
+        summarise(0, &mut nodes, points);
+    }
+    nodes
+}
+
+/// Sample count from the material: spacing of half the shortest diffusion length 1/σtr (in scene
+/// units), within [4096, budget]. Returns the count and the spacing it gives.
+pub fn choose_point_count(surface_area: f32, shortest_diffusion_length: f32, budget: u32) -> (u32, f32) {
+    let spacing = 0.5 * shortest_diffusion_length;
+    let wanted = (surface_area / (spacing * spacing)).ceil();
+    let n = if wanted.is_finite() { (wanted as u64).clamp(4096, budget as u64) as u32 } else { budget };
+    (n, (surface_area / n as f32).sqrt())
+}

@@ -1,0 +1,57 @@
+//! Surface sampling: the triangle-area prefix sum, then N points uniform by area.
+//! Reads: vertices, indices. Writes: area prefix sum, points (unsorted).
+
+use bytemuck::{Pod, Zeroable};
+
+use crate::error::Result;
+use crate::vk::{Bind, BindingKind, Buffer, Context, Pipeline, Recorder};
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct SampleConstants {
+    point_count: u32,
+    triangle_count: u32,
+    seed: u32,
+}
+
+pub struct SamplingPass {
+    areas: Pipeline,
+    points: Pipeline,
+}
+
+impl SamplingPass {
+    pub fn new(ctx: &Context) -> Result<SamplingPass> {
+        use BindingKind::StorageBuffer as S;
+        Ok(SamplingPass {
+            areas: Pipeline::compute(ctx, "hierarchy/triangle_areas.comp", &[S, S, S], 4)?,
+            points: Pipeline::compute(ctx, "hierarchy/sample_points.comp", &[S, S, S, S], 12)?,
+        })
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &self,
+        rec: &mut Recorder,
+        vertices: &Buffer,
+        indices: &Buffer,
+        triangle_count: u32,
+        prefix: &Buffer,
+        points: &Buffer,
+        point_count: u32,
+        seed: u32,
+    ) -> Result<()> {
+        rec.dispatch(
+            &self.areas,
+            &[Bind::Read(vertices), Bind::Read(indices), Bind::Write(prefix)],
+            &triangle_count.to_le_bytes(),
+            [1, 1, 1],
+        )?;
+        let constants = SampleConstants { point_count, triangle_count, seed };
+        rec.dispatch(
+            &self.points,
+            &[Bind::Read(vertices), Bind::Read(indices), Bind::Read(prefix), Bind::Write(points)],
+            bytemuck::bytes_of(&constants),
+            [point_count.div_ceil(64), 1, 1],
+        )
+    }
+}

@@ -1,0 +1,274 @@
+//! The GPU point cloud and tree against CPU references and physical expectations, under validation.
+
+mod common;
+
+use common::{assert_clean, validated_context};
+use glam::{Vec3, Vec3Swizzles};
+use translucent::hierarchy::{reference_tree, Hierarchy, HierarchyOptions, Snapshot, SurfacePoint, LEAF_BIT};
+use translucent::mesh::Mesh;
+use translucent::scene::Light;
+use translucent::vk::BufferUsageFlags;
+
+const ETA: f32 = 1.3;
+
+/// Builds the hierarchy once and downloads it.
+fn build(mesh: &Mesh, lights: &[Light], n: u32) -> Snapshot {
+    let (ctx, counts) = validated_context();
+    let vertices = translucent::vk::upload_buffer(
+        &ctx,
+        "vertices",
+        &mesh.vertex_data(),
+        BufferUsageFlags::VERTEX_BUFFER | BufferUsageFlags::STORAGE_BUFFER,
+    )
+    .unwrap();
+    let indices = translucent::vk::upload_buffer(
+        &ctx,
+        "indices",
+        &mesh.indices,
+        BufferUsageFlags::INDEX_BUFFER | BufferUsageFlags::STORAGE_BUFFER,
+    )
+    .unwrap();
+    let hierarchy =
+        Hierarchy::new(&ctx, mesh, lights, &HierarchyOptions { point_count: n, shadow_resolution: 1024, eta: ETA })
+            .unwrap();
+    ctx.submit(None, |rec| hierarchy.record(rec, &vertices, &indices)).unwrap();
+    let snapshot = hierarchy.download(&ctx).unwrap();
+    drop((hierarchy, vertices, indices));
+    drop(ctx);
+    assert_clean(&counts);
+    snapshot
+}
+
+fn sun(toward: Vec3, e: f32) -> Light {
+    Light::Directional { toward, irradiance: Vec3::splat(e) }
+}
+
+fn ft(cos: f32) -> f32 {
+    translucent::physics::fresnel::transmittance(ETA as f64, cos as f64) as f32
+}
+
+#[test]
+fn gpu_sort_equals_cpu_sort_and_gather_follows_it() {
+    let s = build(&Mesh::from_spec("tests/data/irregular.obj").unwrap(), &[sun(Vec3::Y, 1.0)], 5000);
+    let n = s.keys.len();
+    // Recover the unsorted keys through the permutation, then sort (key, index) on the CPU.
+    let mut unsorted = vec![[0u32; 2]; n];
+    let mut seen = vec![false; n];
+    for (i, &o) in s.order.iter().enumerate() {
+        assert!(!seen[o as usize], "order is not a permutation");
+        seen[o as usize] = true;
+        unsorted[o as usize] = s.keys[i];
+    }
+    let key = |k: [u32; 2]| ((k[1] as u64) << 32) | k[0] as u64;
+    let mut cpu: Vec<(u64, u32)> = unsorted.iter().enumerate().map(|(i, k)| (key(*k), i as u32)).collect();
+    cpu.sort();
+    let gpu: Vec<(u64, u32)> = s.keys.iter().zip(&s.order).map(|(k, &o)| (key(*k), o)).collect();
+    assert_eq!(gpu, cpu, "GPU radix sort differs from the CPU sort");
+    assert!(key(s.keys[n - 1]) < (1 << 63), "keys are 63-bit");
+    for (i, &o) in s.order.iter().enumerate() {
+        assert_eq!(s.sorted_points[i].position, s.points[o as usize].position);
+    }
+}
+
+fn rel(a: f64, b: f64) -> f64 {
+    (a - b).abs() / b.abs().max(1e-12)
+}
+
+fn check_tree(s: &Snapshot) {
+    let n = s.sorted_points.len();
+    let reference = reference_tree(&s.keys, &s.sorted_points);
+    assert_eq!(reference.len(), s.nodes.len());
+    let mut in_leaf = vec![0u32; n];
+    let mut worst = 0.0f64;
+    for (k, (g, r)) in s.nodes.iter().zip(&reference).enumerate() {
+        assert_eq!(
+            (g.left, g.right, g.first_point, g.point_count),
+            (r.left, r.right, r.first_point, r.point_count),
+            "node {k} topology"
+        );
+        assert!(g.point_count >= 2, "node {k} is empty or degenerate");
+        for (a, b) in [(g.power.x, r.power.x), (g.power.y, r.power.y), (g.power.z, r.power.z), (g.area, r.area)] {
+            let scale = r.power.max_element().max(r.area);
+            worst = worst.max((a as f64 - b).abs() / scale.max(1e-30));
+        }
+        for c in 0..3 {
+            let extent = (r.hi - r.lo).max_element().max(1e-9);
+            assert!(
+                ((g.power_center[c] as f64) - r.power_center[c]).abs() <= 1e-4 * extent.max(1.0),
+                "node {k} centre {} vs {} (power {} vs {})",
+                g.power_center,
+                r.power_center,
+                g.power,
+                r.power
+            );
+        }
+        // Directions: 16-bit octahedral, so ~1e-4 rad; where the children's directions cancel the
+        // mean direction is noise (the root of a sphere), so only coherent nodes are compared.
+        if r.normal_coherence > 0.05 {
+            assert!(g.normal().as_dvec3().dot(r.normal) > 0.9999, "node {k} normal");
+        }
+        if r.light_coherence > 0.05 {
+            assert!(g.light_dir().as_dvec3().dot(r.light_dir) > 0.9999, "node {k} light direction");
+        }
+        let (lo, hi) = g.bounds();
+        assert!(
+            lo.as_dvec3().cmple(r.lo).all() && hi.as_dvec3().cmpge(r.hi).all(),
+            "node {k}: box does not contain its points"
+        );
+        for child in [g.left, g.right] {
+            if child & LEAF_BIT != 0 {
+                in_leaf[(child & !LEAF_BIT) as usize] += 1;
+            } else {
+                let (clo, chi) = s.nodes[child as usize].bounds();
+                assert!(clo.cmpge(lo).all() && chi.cmple(hi).all(), "node {child} box outside its parent {k}");
+            }
+        }
+    }
+    assert!(worst <= 1e-4, "power/area differ from the CPU build by {worst:e}");
+    assert!(in_leaf.iter().all(|&c| c == 1), "every point must sit in exactly one leaf (of one point)");
+    let total: f64 = s.sorted_points.iter().map(|p| (p.irradiance.x * p.area) as f64).sum();
+    assert!(rel(s.nodes[0].power.x as f64, total) < 1e-4, "root power {} vs sum {total}", s.nodes[0].power.x);
+    assert_eq!(s.nodes[0].point_count as usize, n);
+}
+
+#[test]
+fn gpu_tree_equals_cpu_build_and_keeps_its_invariants() {
+    check_tree(&build(&Mesh::sphere(1.0, 32), &[sun(Vec3::new(1.0, 1.0, 0.3), 2.0)], 8192));
+    check_tree(&build(&Mesh::from_spec("tests/data/irregular.obj").unwrap(), &[sun(Vec3::Y, 1.0)], 3001));
+}
+
+/// A jittered grid in the xz plane: triangles of many sizes.
+fn irregular_grid(cells: u32) -> Mesh {
+    let mut positions = Vec::new();
+    let mut state = 12345u32;
+    let mut rand = || {
+        state ^= state << 13;
+        state ^= state >> 17;
+        state ^= state << 5;
+        (state as f32 / u32::MAX as f32) - 0.5
+    };
+    for i in 0..=cells {
+        for j in 0..=cells {
+            let interior = i > 0 && j > 0 && i < cells && j < cells;
+            let jitter = if interior { Vec3::new(rand(), 0.0, rand()) * 0.8 } else { Vec3::ZERO };
+            positions.push(Vec3::new(i as f32, 0.0, j as f32) + jitter);
+        }
+    }
+    let mut indices = Vec::new();
+    for i in 0..cells {
+        for j in 0..cells {
+            let a = i * (cells + 1) + j;
+            let b = a + cells + 1;
+            indices.extend_from_slice(&[a, a + 1, b, b, a + 1, b + 1]);
+        }
+    }
+    let normals = vec![Vec3::Y; positions.len()];
+    Mesh { positions, normals, indices }
+}
+
+#[test]
+fn samples_are_uniform_by_area() {
+    let mesh = irregular_grid(20);
+    let n = 24_000u32;
+    let s = build(&mesh, &[sun(Vec3::Y, 1.0)], n);
+    let areas = mesh.triangle_areas();
+    let total: f64 = areas.iter().map(|&a| a as f64).sum();
+    let mut counts = vec![0u32; areas.len()];
+    for p in &s.points {
+        counts[p.triangle as usize] += 1;
+    }
+    let chi2: f64 = counts
+        .iter()
+        .zip(&areas)
+        .map(|(&o, &a)| {
+            let e = n as f64 * a as f64 / total;
+            (o as f64 - e).powi(2) / e
+        })
+        .sum();
+    let dof = (areas.len() - 1) as f64;
+    // Upper 0.1% point of chi-square, normal approximation.
+    let critical = dof + 3.09 * (2.0 * dof).sqrt();
+    println!("chi-square {chi2:.1} with {dof} degrees of freedom (critical {critical:.1})");
+    assert!(chi2 < critical);
+    // And the points lie on their triangles.
+    for p in s.points.iter().take(500) {
+        assert!(p.position.y.abs() < 1e-5 && (p.normal - Vec3::Y).length() < 1e-5);
+    }
+}
+
+#[test]
+fn flat_lit_plane_has_no_self_shadowing() {
+    let slab = Mesh::slab(4.0, 4.0, 1.0);
+    let s = build(&slab, &[sun(Vec3::Y, 3.0)], 8192);
+    let expected = 3.0 * ft(1.0);
+    let top: Vec<&SurfacePoint> = s.points.iter().filter(|p| p.normal.y > 0.99).collect();
+    assert!(top.len() > 1000);
+    for p in top {
+        assert!((p.irradiance.x - expected).abs() < 1e-4 * expected, "{p:?}");
+        assert!((p.light_dir - Vec3::Y).length() < 1e-5);
+    }
+}
+
+fn merge(a: &Mesh, b: &Mesh) -> Mesh {
+    let base = a.positions.len() as u32;
+    Mesh {
+        positions: a.positions.iter().chain(&b.positions).copied().collect(),
+        normals: a.normals.iter().chain(&b.normals).copied().collect(),
+        indices: a.indices.iter().copied().chain(b.indices.iter().map(|i| i + base)).collect(),
+    }
+}
+
+#[test]
+fn occluded_points_get_no_irradiance() {
+    let floor = Mesh::slab(6.0, 6.0, 0.2);
+    let blocker = Mesh::slab(2.0, 2.0, 0.2).scaled(1.0);
+    let blocker =
+        Mesh { positions: blocker.positions.iter().map(|p| *p + Vec3::new(0.0, 1.5, 0.0)).collect(), ..blocker };
+    let s = build(&merge(&floor, &blocker), &[sun(Vec3::Y, 1.0)], 16_384);
+    let shadowed: Vec<&SurfacePoint> = s
+        .points
+        .iter()
+        .filter(|p| p.normal.y > 0.99 && p.position.y < 0.2 && p.position.xz().abs().max_element() < 0.8)
+        .collect();
+    let lit: Vec<&SurfacePoint> = s
+        .points
+        .iter()
+        .filter(|p| p.normal.y > 0.99 && p.position.y < 0.2 && p.position.xz().abs().min_element() > 1.5)
+        .collect();
+    assert!(shadowed.len() > 50 && lit.len() > 50);
+    assert!(shadowed.iter().all(|p| p.irradiance == Vec3::ZERO), "points under the blocker are lit");
+    assert!(lit.iter().all(|p| p.irradiance.x > 0.9 * ft(1.0)), "open floor points are dark");
+}
+
+#[test]
+fn sphere_lit_from_one_side_splits_at_the_terminator() {
+    let light = Vec3::X;
+    let s = build(&Mesh::sphere(1.0, 48), &[sun(light, 1.0)], 8192);
+    for p in &s.points {
+        let cos = p.normal.dot(light);
+        if cos < 0.0 {
+            assert_eq!(p.irradiance, Vec3::ZERO, "unlit half: {p:?}");
+        } else if cos > 0.1 {
+            let expected = cos * ft(cos);
+            assert!((p.irradiance.x - expected).abs() < 1e-3 + 1e-3 * expected, "lit half: {p:?} expected {expected}");
+        }
+    }
+}
+
+#[test]
+fn irradiance_of_two_lights_is_the_sum_of_each() {
+    let mesh = Mesh::torus(1.0, 0.35, 48, 24);
+    let a = sun(Vec3::new(0.3, 1.0, 0.2), 1.0);
+    let b = Light::Point { position: Vec3::new(-2.0, 1.5, 1.0), intensity: Vec3::new(4.0, 2.0, 1.0) };
+    let both = build(&mesh, &[a, b], 4096);
+    let only_a = build(&mesh, &[a], 4096);
+    let only_b = build(&mesh, &[b], 4096);
+    let mut lit_by_b = 0;
+    for ((ab, pa), pb) in both.points.iter().zip(&only_a.points).zip(&only_b.points) {
+        assert_eq!(ab.position, pa.position);
+        let sum = pa.irradiance + pb.irradiance;
+        assert!((ab.irradiance - sum).abs().max_element() <= 1e-5 * sum.max_element().max(1.0), "{ab:?} vs {sum}");
+        lit_by_b += (pb.irradiance.x > 0.0) as u32;
+    }
+    assert!(lit_by_b > 100, "the point light must light part of the torus");
+}
