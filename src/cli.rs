@@ -6,7 +6,8 @@ use clap::{Args, Parser, Subcommand};
 use glam::Vec3;
 
 use crate::error::Result;
-use crate::frame::Renderer;
+use crate::frame::{FrameOptions, Renderer, Show};
+use crate::hierarchy::HierarchyOptions;
 use crate::materials::Material;
 use crate::mesh::Mesh;
 use crate::output::{self, Exposure};
@@ -34,6 +35,13 @@ pub enum Command {
     Bssrdf(BssrdfArgs),
     /// Plot Sd against distance per RGB channel for a material (PNG, SVG or CSV).
     Profile(Box<ProfileArgs>),
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ShowArg {
+    Shading,
+    Samples,
+    Tree,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -200,6 +208,25 @@ pub struct RenderArgs {
     /// Irradiance at normal incidence: one value or R,G,B.
     #[arg(long, allow_hyphen_values = true, value_parser = rgb, value_name = "I|R,G,B", default_value = "1")]
     pub light_intensity: Vec3,
+    /// A light (repeatable, up to 8; replaces the default light): `dir:X,Y,Z[:I]` (direction toward
+    /// the light; I = irradiance at normal incidence, one value or R,G,B) or `point:X,Y,Z[:I]`
+    /// (position; I = radiant intensity, falling off with the squared distance).
+    #[arg(long = "light", value_parser = light_spec, value_name = "dir:X,Y,Z[:I] | point:X,Y,Z[:I]")]
+    pub lights: Vec<Light>,
+    /// Sample points on the surface (default: from the material's diffusion length and the mesh's area).
+    #[arg(long, allow_hyphen_values = true, value_parser = clap::value_parser!(u32))]
+    pub samples: Option<u32>,
+    /// Shadow-map resolution per light (per cube face for point lights).
+    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(16..=8192))]
+    pub shadow_resolution: u32,
+    /// Draw a debug view over the mesh: the sample points or the tree's boxes at --level.
+    #[arg(long, value_enum, default_value = "shading")]
+    pub show: ShowArg,
+    /// Tree level for `--show tree` (0 = the root).
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(0..=64))]
+    pub level: u32,
+    #[command(flatten)]
+    pub material: MaterialArgs,
     /// Exposure in stops (default: automatic from the image).
     #[arg(long, allow_hyphen_values = true, value_parser = finite_f32)]
     pub exposure: Option<f32>,
@@ -225,6 +252,21 @@ fn triple(s: &str) -> std::result::Result<[f64; 3], String> {
         [r, g, b] => Ok([*r, *g, *b]),
         _ => Err(format!("'{s}' is neither one number nor R,G,B")),
     }
+}
+
+fn light_spec(s: &str) -> std::result::Result<Light, String> {
+    let mut parts = s.splitn(3, ':');
+    let kind = parts.next().unwrap_or("");
+    let at = parts.next().ok_or_else(|| format!("'{s}': expected dir:X,Y,Z[:I] or point:X,Y,Z[:I]"))?;
+    let v = vec3(at)?;
+    let intensity = parts.next().map(rgb).transpose()?.unwrap_or(Vec3::ONE);
+    let light = match kind {
+        "dir" => Light::Directional { toward: v, irradiance: intensity },
+        "point" => Light::Point { position: v, intensity },
+        _ => return Err(format!("'{s}': the kind must be dir or point, not '{kind}'")),
+    };
+    light.validate().map_err(|e| e.to_string())?;
+    Ok(light)
 }
 
 fn finite_f32(s: &str) -> std::result::Result<f32, String> {
@@ -366,7 +408,18 @@ pub fn build_scene(args: &RenderArgs) -> Result<Scene> {
     if let Some(eye) = args.eye {
         camera.eye = eye;
     }
-    let lights = vec![Light::Directional { toward: args.light_dir, irradiance: args.light_intensity }];
+    let lights = if args.lights.is_empty() {
+        vec![Light::Directional { toward: args.light_dir, irradiance: args.light_intensity }]
+    } else {
+        args.lights.clone()
+    };
+    if lights.len() > crate::passes::irradiance::MAX_LIGHTS {
+        return Err(bad_input!(
+            "--light: at most {} lights, {} given",
+            crate::passes::irradiance::MAX_LIGHTS,
+            lights.len()
+        ));
+    }
     let scene = Scene { mesh, camera, lights, mm_per_unit: args.scale };
     scene.validate()?;
     Ok(scene)
@@ -393,7 +446,31 @@ fn render(args: &RenderArgs) -> Result<i32> {
     let profiling = args.profile || args.profile_out.is_some();
     let device_name = format!("{} ({})", ctx.info.name, ctx.info.driver);
 
-    let mut renderer = Renderer::new(ctx, &scene, args.width, args.height, profiling)?;
+    let material = args.material.material()?;
+    let point_count = match args.samples {
+        Some(n) => {
+            crate::hierarchy::check_point_count(&ctx, n)?;
+            n
+        }
+        None => default_point_count(&ctx, &scene, &material),
+    };
+    let show = match args.show {
+        ShowArg::Shading => Show::Shading,
+        ShowArg::Samples => Show::Samples,
+        ShowArg::Tree => Show::Tree(args.level),
+    };
+    let options = FrameOptions {
+        width: args.width,
+        height: args.height,
+        profile: profiling,
+        hierarchy: HierarchyOptions {
+            point_count,
+            shadow_resolution: args.shadow_resolution,
+            eta: material.eta as f32,
+        },
+        show,
+    };
+    let mut renderer = Renderer::new(ctx, &scene, options)?;
     let mut frames = Vec::new();
     for _ in 0..args.frames {
         frames.push(renderer.render_frame(&scene)?);
@@ -409,6 +486,27 @@ fn render(args: &RenderArgs) -> Result<i32> {
         report_profile(&device_name, frames, args)?;
     }
     Ok(validation_exit_code(validating, &counts))
+}
+
+/// Sample count from the material's shortest diffusion length 1/σtr and the mesh's area (in mm),
+/// within a budget; prints the choice and warns when points are farther apart than 1/σtr.
+fn default_point_count(ctx: &Context, scene: &Scene, material: &Material) -> u32 {
+    let mm = scene.mm_per_unit;
+    let area_mm2 = scene.mesh.surface_area() * mm * mm;
+    let shortest = (0..3)
+        .map(|ch| material.channel(ch).constants(Diffusion::Classical))
+        .filter(|c| c.transports && c.sigma_tr > 0.0)
+        .map(|c| 1.0 / c.sigma_tr)
+        .fold(f64::INFINITY, f64::min) as f32;
+    let budget = crate::hierarchy::max_points(ctx).min(1 << 18);
+    let (n, spacing) = crate::hierarchy::choose_point_count(area_mm2, shortest, budget);
+    eprintln!(
+        "samples: {n} points, {spacing:.3} mm apart on {area_mm2:.0} mm² (shortest diffusion length 1/σtr = {shortest:.3} mm)"
+    );
+    if spacing > shortest {
+        eprintln!("warning: points are spaced wider than the diffusion length; raise --samples for accuracy");
+    }
+    n
 }
 
 fn report_profile(device: &str, frames: Vec<Vec<vk::TimedScope>>, args: &RenderArgs) -> Result<()> {

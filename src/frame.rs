@@ -3,7 +3,9 @@
 use glam::Vec3;
 
 use crate::error::Result;
+use crate::hierarchy::{Hierarchy, HierarchyOptions};
 use crate::output::HdrImage;
+use crate::passes::debug_view::{self, DebugConstants, DebugViewPass};
 use crate::passes::shade::{self, ShadeConstants, ShadePass};
 use crate::scene::Scene;
 use crate::vk::{
@@ -14,10 +16,31 @@ use crate::{bad_input, runtime};
 /// The most timestamp scopes one frame may open.
 const MAX_SCOPES: u32 = 64;
 
+/// What to draw over the shaded mesh for debugging.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Show {
+    Shading,
+    /// The sample points coloured by irradiance.
+    Samples,
+    /// The boxes of the tree nodes this many levels below the root.
+    Tree(u32),
+}
+
+pub struct FrameOptions {
+    pub width: u32,
+    pub height: u32,
+    pub profile: bool,
+    pub hierarchy: HierarchyOptions,
+    pub show: Show,
+}
+
 pub struct Renderer {
     // Field order is drop order: every resource before the context.
     profiler: Option<GpuProfiler>,
+    pub hierarchy: Hierarchy,
     shade: ShadePass,
+    debug_view: DebugViewPass,
+    show: Show,
     vertices: Buffer,
     indices: Buffer,
     index_count: u32,
@@ -31,7 +54,8 @@ pub struct Renderer {
 
 impl Renderer {
     /// Uploads the scene's mesh and creates the targets for `width` x `height` images.
-    pub fn new(ctx: Context, scene: &Scene, width: u32, height: u32, profile: bool) -> Result<Renderer> {
+    pub fn new(ctx: Context, scene: &Scene, options: FrameOptions) -> Result<Renderer> {
+        let FrameOptions { width, height, profile, hierarchy, show } = options;
         let max = ctx.limits().max_image_dimension2_d;
         if width == 0 || height == 0 || width > max || height > max {
             return Err(bad_input!(
@@ -77,9 +101,13 @@ impl Renderer {
         let readback =
             Buffer::new(&ctx, "readback", readback_bytes, BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)?;
         let shade = ShadePass::new(&ctx)?;
+        let hierarchy = Hierarchy::new(&ctx, &scene.mesh, &scene.lights, &hierarchy)?;
         Ok(Renderer {
             profiler,
+            hierarchy,
             shade,
+            debug_view: DebugViewPass::new(&ctx)?,
+            show,
             vertices,
             indices,
             index_count,
@@ -103,7 +131,10 @@ impl Renderer {
             p.begin_frame();
         }
         self.ctx.submit(self.profiler.as_mut(), |rec| {
-            // The frame, in order.
+            // The frame, in order: the hierarchy (sampling, shadow maps, irradiance, Morton codes,
+            // sort, tree build, summaries; each its own scope), then shading and read-back.
+            self.hierarchy.record(rec, &self.vertices, &self.indices)?;
+
             rec.begin_scope("shade");
             self.shade.record(
                 rec,
@@ -116,6 +147,36 @@ impl Renderer {
             )?;
             rec.end_scope();
 
+            if self.show == Show::Samples {
+                rec.begin_scope("show samples");
+                let debug = DebugConstants { view_projection, color_scale: Vec3::ONE.extend(2.0) };
+                let n = self.hierarchy.point_count;
+                self.debug_view.record_points(
+                    rec,
+                    &self.color,
+                    &self.depth,
+                    &self.hierarchy.sorted_points,
+                    n,
+                    &debug,
+                )?;
+                rec.end_scope();
+            }
+            Ok(())
+        })?;
+        if let Show::Tree(level) = self.show {
+            // Debug only: the boxes come from a download of the nodes, drawn in a second submission.
+            let nodes = self.hierarchy.download(&self.ctx)?.nodes;
+            let lines = debug_view::tree_level_lines(&nodes, level);
+            if lines.is_empty() {
+                return Err(crate::bad_input!("--level {level}: the tree has no internal nodes that deep"));
+            }
+            let buffer = vk::upload_buffer(&self.ctx, "tree lines", &lines, BufferUsageFlags::VERTEX_BUFFER)?;
+            let debug = DebugConstants { view_projection, color_scale: Vec3::ONE.extend(1.0) };
+            self.ctx.submit(None, |rec| {
+                self.debug_view.record_lines(rec, &self.color, &self.depth, &buffer, lines.len() as u32, &debug)
+            })?;
+        }
+        self.ctx.submit(self.profiler.as_mut(), |rec| {
             rec.begin_scope("readback");
             rec.copy_image_to_buffer(&self.color, &self.readback)?;
             rec.end_scope();

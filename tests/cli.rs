@@ -69,3 +69,16 @@ fn bad_output_extension() {
     assert_eq!(result.status.code(), Some(2));
     assert!(stderr(&result).contains("picture.bmp"));
 }
+
+#[test]
+fn bad_hierarchy_input() {
+    assert_bad_input(&["--samples", "0"], "--samples 0");
+    assert_bad_input(&["--samples", "4000000000"], "more than this device can hold");
+    assert_bad_input(&["--light", "point:0,0,0:5"], "inside the mesh");
+    assert_bad_input(&["--light", "dir:nan,1,0"], "--light");
+    assert_bad_input(&["--light", "point:1,nan,0"], "--light");
+    assert_bad_input(&["--light", "spot:1,1,1"], "kind must be dir or point");
+    assert_bad_input(&["--light", "dir:0,1,0:-2"], "--light");
+    let nine: Vec<&str> = (0..9).flat_map(|_| ["--light", "dir:0,1,0"]).collect();
+    assert_bad_input(&nine, "at most 8 lights");
+}

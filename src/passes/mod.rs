@@ -1,6 +1,7 @@
 //! GPU passes: each is one shader (or a few stages of one) plus one file here.
 
 pub mod bssrdf_eval;
+pub mod debug_view;
 pub mod irradiance;
 pub mod sampling;
 pub mod shade;
