@@ -35,6 +35,27 @@ pub enum Command {
     Bssrdf(BssrdfArgs),
     /// Plot Sd against distance per RGB channel for a material (PNG, SVG or CSV).
     Profile(Box<ProfileArgs>),
+    /// Time every pass (GPU timestamps) for several sample counts and meshes; prints Markdown.
+    Bench(BenchArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    /// Meshes (built-in names or OBJ paths); the bunny is used when installed.
+    #[arg(long, value_delimiter = ',')]
+    pub meshes: Option<Vec<String>>,
+    /// Sample counts.
+    #[arg(long, value_delimiter = ',', default_values = ["16384", "65536", "262144", "1048576"])]
+    pub samples: Vec<u32>,
+    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    pub width: u32,
+    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    pub height: u32,
+    /// Frames per configuration (the first is a warm-up).
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(2..=1000))]
+    pub frames: u32,
+    #[command(flatten)]
+    pub device: DeviceArgs,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -319,6 +340,26 @@ pub fn run(cli: Cli) -> Result<i32> {
         }
         Command::Bssrdf(args) => bssrdf(&args),
         Command::Profile(args) => profile(&args),
+        Command::Bench(args) => {
+            let bunny = "/usr/share/glmark2/models/bunny.obj";
+            let meshes = args.meshes.clone().unwrap_or_else(|| {
+                let mut m = vec!["sphere".to_string()];
+                if std::path::Path::new(bunny).exists() {
+                    m.insert(0, bunny.to_string());
+                }
+                m
+            });
+            let options = crate::bench::BenchOptions {
+                meshes,
+                samples: args.samples.clone(),
+                width: args.width,
+                height: args.height,
+                frames: args.frames,
+                context: args.device.options(),
+            };
+            print!("{}", crate::bench::run(&options)?);
+            Ok(0)
+        }
     }
 }
 
