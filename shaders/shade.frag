@@ -1,27 +1,70 @@
 #version 460
-// Placeholder surface shading until the subsurface pass exists: Lambert from one light plus a
-// little ambient. Output is linear radiance; alpha marks covered pixels.
+// Subsurface scattering per pixel: walks the Jensen–Buhler tree from the root with an explicit
+// stack; a node far and small enough (area / distance² < epsilon, and xo outside its box) is one
+// source at its power centre, otherwise its children are visited; points are evaluated singly.
+// Lo(xo, wo) = Ft(eta, wo) · Σ Sd(xi, wi; xo, no) · power_i, power = E·A (mm²).
 #include "common.glsl"
 #include "shade_constants.glsl"
+#include "points.glsl"
+#include "subsurface_params.glsl"
 
 layout(location = 0) in vec3 world_position;
 layout(location = 1) in vec3 world_normal;
 layout(location = 0) out vec4 radiance;
 
-void main() {
-    vec3 n = normalize(world_normal);
-    // Seen from behind (open meshes): shade the side that faces the viewer.
-    if (dot(n, pc.eye.xyz - world_position) < 0.0) n = -n;
-    vec3 toward = pc.light_toward.xyz;
-    vec3 irradiance = pc.light_irradiance.rgb;
-    if (pc.light_toward.w > 0.5) {
-        vec3 d = pc.light_toward.xyz - world_position;
-        float d2 = max(dot(d, d), 1e-12);
-        toward = d * inversesqrt(d2);
-        irradiance /= d2;
+layout(std430, binding = 0) readonly buffer Params { SubsurfaceParams params; };
+layout(std430, binding = 1) readonly buffer Nodes { TreeNode nodes[]; };
+layout(std430, binding = 2) readonly buffer Sorted { SurfacePoint points[]; };
+
+const uint STACK_SIZE = 96u;
+
+vec3 source(vec3 xi, vec3 ni, vec3 wi, vec3 power, vec3 xo, vec3 no) {
+    float s = params.mm_per_unit;
+    vec3 sd;
+    for (int c = 0; c < 3; ++c) {
+        sd[c] = params.model == 0u ? dirpole_sd(params.channels[c], xi * s, ni, wi, xo * s, no)
+                                   : dipole_sd(params.channels[c], length(xo - xi) * s);
     }
-    float cos_theta = max(dot(n, toward), 0.0);
-    vec3 albedo = pc.albedo.rgb;
-    vec3 lo = albedo / PI * irradiance * (cos_theta + pc.albedo.a);
-    radiance = vec4(lo, 1.0);
+    return sd * power * (s * s); // power is irradiance × scene-unit area: to mm²
+}
+
+vec3 point_source(uint i, vec3 xo, vec3 no) {
+    SurfacePoint p = points[i];
+    if (p.irradiance == vec3(0.0)) return vec3(0.0);
+    return source(p.position, p.normal, p.light_dir, p.irradiance * p.area, xo, no);
+}
+
+void main() {
+    vec3 xo = world_position;
+    vec3 no = normalize(world_normal);
+    vec3 wo = normalize(pc.eye.xyz - xo);
+    vec3 sum = vec3(0.0);
+    if (params.brute_force != 0u || params.node_count == 0u) {
+        for (uint i = 0u; i < params.point_count; ++i) sum += point_source(i, xo, no);
+    } else {
+        uint stack[STACK_SIZE];
+        uint top = 0u;
+        stack[top++] = 0u;
+        while (top > 0u) {
+            TreeNode node = nodes[stack[--top]];
+            if (node.power == vec3(0.0)) continue;
+            vec3 lo, hi;
+            unpack_box(node.box_half, lo, hi);
+            vec3 d = node.power_center - xo;
+            bool inside = all(greaterThanEqual(xo, lo)) && all(lessThanEqual(xo, hi));
+            // A full stack also ends the descent: the node is then used whole (never overflows).
+            if ((!inside && node.area < params.epsilon * dot(d, d)) || top + 2u > STACK_SIZE) {
+                sum += source(node.power_center, decode_oct(node.normal_oct), decode_oct(node.light_oct), node.power, xo, no);
+                continue;
+            }
+            uint children[2] = uint[2](node.left, node.right);
+            for (int k = 0; k < 2; ++k) {
+                uint child = children[k];
+                if ((child & LEAF_BIT) != 0u) sum += point_source(child & ~LEAF_BIT, xo, no);
+                else stack[top++] = child;
+            }
+        }
+    }
+    float cos_o = max(dot(no, wo), 0.0);
+    radiance = vec4(fresnel_transmittance(params.channels[0].eta, cos_o) * sum, 1.0);
 }

@@ -4,7 +4,7 @@
 use glam::Vec3;
 
 use crate::error::Result;
-use crate::frame::{FrameOptions, Renderer, Show};
+use crate::frame::{FrameOptions, Renderer, Show, SubsurfaceOptions};
 use crate::hierarchy::{self, HierarchyOptions};
 use crate::mesh::Mesh;
 use crate::profiling::{summary, ProfileReport, Scope};
@@ -37,6 +37,13 @@ pub fn run(options: &BenchOptions) -> Result<String> {
                 continue;
             }
             let frame_options = FrameOptions {
+                subsurface: SubsurfaceOptions {
+                    material: crate::materials::Material::find("marble")?,
+                    model: crate::physics::Model::Directional,
+                    diffusion: crate::physics::Diffusion::Classical,
+                    epsilon: 0.05,
+                    brute_force: false,
+                },
                 width: options.width,
                 height: options.height,
                 profile: true,
@@ -47,12 +54,22 @@ pub fn run(options: &BenchOptions) -> Result<String> {
             let mut frames = Vec::new();
             for _ in 0..options.frames.max(2) {
                 let scopes = renderer.render_frame(&scene)?;
-                frames.push(scopes.into_iter().map(|s| Scope { name: s.name, begin_ns: s.begin_ns, end_ns: s.end_ns }).collect());
+                frames.push(
+                    scopes
+                        .into_iter()
+                        .map(|s| Scope { name: s.name, begin_ns: s.begin_ns, end_ns: s.end_ns })
+                        .collect(),
+                );
             }
             frames.remove(0);
             let rows = summary(&ProfileReport { device: device.clone(), frames });
             if !header_done {
-                out += &format!("Device: {device}; {}x{}, mean of {} frames after one warm-up frame.\n\n", options.width, options.height, options.frames.max(2) - 1);
+                out += &format!(
+                    "Device: {device}; {}x{}, mean of {} frames after one warm-up frame.\n\n",
+                    options.width,
+                    options.height,
+                    options.frames.max(2) - 1
+                );
                 out += "| mesh | points | ";
                 out += &rows.iter().map(|r| format!("{} ms", r.name)).collect::<Vec<_>>().join(" | ");
                 out += " | hierarchy MiB |\n|---|---:|";

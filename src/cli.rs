@@ -6,7 +6,7 @@ use clap::{Args, Parser, Subcommand};
 use glam::Vec3;
 
 use crate::error::Result;
-use crate::frame::{FrameOptions, Renderer, Show};
+use crate::frame::{FrameOptions, Renderer, Show, SubsurfaceOptions};
 use crate::hierarchy::HierarchyOptions;
 use crate::materials::Material;
 use crate::mesh::Mesh;
@@ -248,6 +248,17 @@ pub struct RenderArgs {
     pub level: u32,
     #[command(flatten)]
     pub material: MaterialArgs,
+    /// BSSRDF model.
+    #[arg(long, value_enum, default_value = "directional")]
+    pub model: ModelArg,
+    #[arg(long, value_enum, default_value = "classical")]
+    pub diffusion: DiffusionArg,
+    /// Use a tree node as one source when its area / squared distance is below this.
+    #[arg(long, allow_hyphen_values = true, default_value_t = 0.05, value_parser = finite_f32)]
+    pub epsilon: f32,
+    /// Visit every sample point for every pixel (the reference for the tree).
+    #[arg(long)]
+    pub brute_force: bool,
     /// Exposure in stops (default: automatic from the image).
     #[arg(long, allow_hyphen_values = true, value_parser = finite_f32)]
     pub exposure: Option<f32>,
@@ -488,6 +499,7 @@ fn render(args: &RenderArgs) -> Result<i32> {
     let device_name = format!("{} ({})", ctx.info.name, ctx.info.driver);
 
     let material = args.material.material()?;
+    let eta = material.eta as f32;
     let point_count = match args.samples {
         Some(n) => {
             crate::hierarchy::check_point_count(&ctx, n)?;
@@ -501,14 +513,17 @@ fn render(args: &RenderArgs) -> Result<i32> {
         ShowArg::Tree => Show::Tree(args.level),
     };
     let options = FrameOptions {
+        subsurface: SubsurfaceOptions {
+            material,
+            model: args.model.into(),
+            diffusion: args.diffusion.into(),
+            epsilon: args.epsilon,
+            brute_force: args.brute_force,
+        },
         width: args.width,
         height: args.height,
         profile: profiling,
-        hierarchy: HierarchyOptions {
-            point_count,
-            shadow_resolution: args.shadow_resolution,
-            eta: material.eta as f32,
-        },
+        hierarchy: HierarchyOptions { point_count, shadow_resolution: args.shadow_resolution, eta },
         show,
     };
     let mut renderer = Renderer::new(ctx, &scene, options)?;

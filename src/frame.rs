@@ -4,14 +4,33 @@ use glam::Vec3;
 
 use crate::error::Result;
 use crate::hierarchy::{Hierarchy, HierarchyOptions};
+use crate::materials::Material;
 use crate::output::HdrImage;
 use crate::passes::debug_view::{self, DebugConstants, DebugViewPass};
-use crate::passes::shade::{self, ShadeConstants, ShadePass};
+use crate::passes::shade::{self, ShadeConstants, ShadePass, SubsurfaceParams};
+use crate::physics::{Diffusion, GpuChannel, Model};
 use crate::scene::Scene;
 use crate::vk::{
     self, Buffer, BufferUsageFlags, Context, Extent2D, GpuProfiler, Image, ImageUsageFlags, MemoryLocation, TimedScope,
 };
 use crate::{bad_input, runtime};
+
+fn subsurface_params(o: &SubsurfaceOptions, mm_per_unit: f32, point_count: u32) -> SubsurfaceParams {
+    let channel = |c: usize| GpuChannel::from(&o.material.channel(c).constants(o.diffusion));
+    SubsurfaceParams {
+        channels: [channel(0), channel(1), channel(2)],
+        mm_per_unit,
+        epsilon: o.epsilon,
+        model: match o.model {
+            Model::Directional => 0,
+            Model::Dipole => 1,
+        },
+        brute_force: o.brute_force as u32,
+        point_count,
+        node_count: point_count - 1,
+        pad: [0; 2],
+    }
+}
 
 /// The most timestamp scopes one frame may open.
 const MAX_SCOPES: u32 = 64;
@@ -26,7 +45,19 @@ pub enum Show {
     Tree(u32),
 }
 
+/// How the subsurface term is integrated.
+pub struct SubsurfaceOptions {
+    pub material: Material,
+    pub model: Model,
+    pub diffusion: Diffusion,
+    /// A node is used whole when its area / squared distance is below this.
+    pub epsilon: f32,
+    /// Sum over every point instead of walking the tree (the reference).
+    pub brute_force: bool,
+}
+
 pub struct FrameOptions {
+    pub subsurface: SubsurfaceOptions,
     pub width: u32,
     pub height: u32,
     pub profile: bool,
@@ -38,6 +69,7 @@ pub struct Renderer {
     // Field order is drop order: every resource before the context.
     profiler: Option<GpuProfiler>,
     pub hierarchy: Hierarchy,
+    subsurface_params: Buffer,
     shade: ShadePass,
     debug_view: DebugViewPass,
     show: Show,
@@ -55,7 +87,10 @@ pub struct Renderer {
 impl Renderer {
     /// Uploads the scene's mesh and creates the targets for `width` x `height` images.
     pub fn new(ctx: Context, scene: &Scene, options: FrameOptions) -> Result<Renderer> {
-        let FrameOptions { width, height, profile, hierarchy, show } = options;
+        let FrameOptions { subsurface, width, height, profile, hierarchy, show } = options;
+        if !(subsurface.epsilon.is_finite() && subsurface.epsilon >= 0.0) {
+            return Err(bad_input!("--epsilon {}: must be a finite number ≥ 0", subsurface.epsilon));
+        }
         let max = ctx.limits().max_image_dimension2_d;
         if width == 0 || height == 0 || width > max || height > max {
             return Err(bad_input!(
@@ -102,9 +137,19 @@ impl Renderer {
             Buffer::new(&ctx, "readback", readback_bytes, BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)?;
         let shade = ShadePass::new(&ctx)?;
         let hierarchy = Hierarchy::new(&ctx, &scene.mesh, &scene.lights, &hierarchy)?;
+        let params = subsurface_params(&subsurface, scene.mm_per_unit, hierarchy.point_count);
+        let mut subsurface_params = Buffer::new(
+            &ctx,
+            "subsurface parameters",
+            std::mem::size_of::<SubsurfaceParams>() as u64,
+            BufferUsageFlags::STORAGE_BUFFER,
+            MemoryLocation::CpuToGpu,
+        )?;
+        subsurface_params.write(0, &[params])?;
         Ok(Renderer {
             profiler,
             hierarchy,
+            subsurface_params,
             shade,
             debug_view: DebugViewPass::new(&ctx)?,
             show,
@@ -144,6 +189,9 @@ impl Renderer {
                 &self.indices,
                 self.index_count,
                 &constants,
+                &self.subsurface_params,
+                &self.hierarchy.nodes,
+                &self.hierarchy.sorted_points,
             )?;
             rec.end_scope();
 

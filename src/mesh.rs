@@ -246,6 +246,8 @@ impl Mesh {
 /// empty mesh), and faces with fewer than 3 vertices are dropped. Also names the line.
 fn check_obj_text(text: &str) -> std::result::Result<(), String> {
     let mut vertices = 0i64;
+    let mut texcoords = 0i64;
+    let mut normals = 0i64;
     let mut faces = 0usize;
     for (number, line) in text.lines().enumerate() {
         let line = line.trim();
@@ -272,19 +274,35 @@ fn check_obj_text(text: &str) -> std::result::Result<(), String> {
                     return Err(format!("line {at}: a face needs at least 3 vertices (truncated face?): '{line}'"));
                 }
                 for corner in corners {
-                    let index = corner.split('/').next().unwrap_or("");
-                    let i: i64 = index.parse().map_err(|_| format!("line {at}: '{corner}' is not a vertex index"))?;
-                    // OBJ indices are 1-based; negative ones count back from the last vertex so far.
-                    let resolved = if i < 0 { vertices + 1 + i } else { i };
-                    if i == 0 || resolved < 1 || resolved > vertices {
-                        return Err(format!(
-                            "line {at}: vertex index {i} is out of range ({vertices} vertices defined so far)"
-                        ));
+                    // v, v/vt, v//vn or v/vt/vn. tobj drops bad vt/vn references silently (and
+                    // overflows on negative ones in debug builds), so all three are checked here.
+                    let mut parts = corner.split('/');
+                    for (kind, defined) in
+                        [("vertex", vertices), ("texture coordinate", texcoords), ("normal", normals)]
+                    {
+                        let Some(index) = parts.next() else { break };
+                        if index.is_empty() && kind != "vertex" {
+                            continue;
+                        }
+                        let i: i64 =
+                            index.parse().map_err(|_| format!("line {at}: '{corner}' is not a valid face corner"))?;
+                        // OBJ indices are 1-based; negative ones count back from the last one so far.
+                        let resolved = if i < 0 { defined + 1 + i } else { i };
+                        if i == 0 || resolved < 1 || resolved > defined {
+                            return Err(format!(
+                                "line {at}: {kind} index {i} is out of range ({defined} defined so far)"
+                            ));
+                        }
+                    }
+                    if parts.next().is_some() {
+                        return Err(format!("line {at}: '{corner}' has more than three indices"));
                     }
                 }
                 faces += 1;
             }
-            "vn" | "vt" | "vp" | "o" | "g" | "s" | "usemtl" | "mtllib" | "l" | "p" => {}
+            "vt" => texcoords += 1,
+            "vn" => normals += 1,
+            "vp" | "o" | "g" | "s" | "usemtl" | "mtllib" | "l" | "p" => {}
             k if k.starts_with('#') => {}
             _ => return Err(format!("line {at}: not an OBJ statement: '{}'", truncate(line))),
         }

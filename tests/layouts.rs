@@ -13,10 +13,64 @@ fn shade_constants_match_glsl() {
         offset_of!(ShadeConstants, light_toward) as u32,
         offset_of!(ShadeConstants, light_irradiance) as u32,
         offset_of!(ShadeConstants, eye) as u32,
-        offset_of!(ShadeConstants, albedo) as u32,
     ];
     assert_eq!(glsl, rust);
-    assert_eq!(size_of::<ShadeConstants>(), 128);
+    assert_eq!(size_of::<ShadeConstants>(), 112);
+}
+
+#[test]
+fn subsurface_params_and_tree_match_glsl() {
+    use translucent::hierarchy::{SurfacePoint, TreeNode};
+    use translucent::passes::shade::SubsurfaceParams;
+    let params = member_offsets("shade.frag", "SubsurfaceParams").expect("SubsurfaceParams");
+    let rust: Vec<u32> = [
+        offset_of!(SubsurfaceParams, channels),
+        offset_of!(SubsurfaceParams, mm_per_unit),
+        offset_of!(SubsurfaceParams, epsilon),
+        offset_of!(SubsurfaceParams, model),
+        offset_of!(SubsurfaceParams, brute_force),
+        offset_of!(SubsurfaceParams, point_count),
+        offset_of!(SubsurfaceParams, node_count),
+        offset_of!(SubsurfaceParams, pad),
+    ]
+    .iter()
+    .map(|&o| o as u32)
+    .collect();
+    assert_eq!(params[..7], rust[..7]);
+    let node = member_offsets("shade.frag", "TreeNode").expect("TreeNode");
+    let rust: Vec<u32> = [
+        offset_of!(TreeNode, power),
+        offset_of!(TreeNode, area),
+        offset_of!(TreeNode, power_center),
+        offset_of!(TreeNode, left),
+        offset_of!(TreeNode, box_half),
+        offset_of!(TreeNode, right),
+        offset_of!(TreeNode, normal_oct),
+        offset_of!(TreeNode, light_oct),
+        offset_of!(TreeNode, first_point),
+        offset_of!(TreeNode, point_count),
+    ]
+    .iter()
+    .map(|&o| o as u32)
+    .collect();
+    assert_eq!(node, rust);
+    assert_eq!(size_of::<TreeNode>(), 64);
+    let point = member_offsets("shade.frag", "SurfacePoint").expect("SurfacePoint");
+    let rust: Vec<u32> = [
+        offset_of!(SurfacePoint, position),
+        offset_of!(SurfacePoint, area),
+        offset_of!(SurfacePoint, normal),
+        offset_of!(SurfacePoint, triangle),
+        offset_of!(SurfacePoint, irradiance),
+        offset_of!(SurfacePoint, pad0),
+        offset_of!(SurfacePoint, light_dir),
+        offset_of!(SurfacePoint, pad1),
+    ]
+    .iter()
+    .map(|&o| o as u32)
+    .collect();
+    assert_eq!(point, rust);
+    assert_eq!(size_of::<SurfacePoint>(), 64);
 }
 
 #[test]

@@ -56,6 +56,14 @@ fn malformed_obj_files_are_refused_with_the_reason() {
         ("empty.obj", "no faces"),
         ("nan_vertex.obj", "not finite"),
         ("zero_area.obj", "zero surface area"),
+        // Cases found by reading tobj 4.0.5: it drops or misreads these without an error.
+        ("normal_index_out_of_range.obj", "normal index"),
+        ("normal_index_negative.obj", "normal index -3"),
+        ("texcoord_index_out_of_range.obj", "texture coordinate index"),
+        ("forward_reference.obj", "out of range"),
+        ("index_zero.obj", "vertex index 0"),
+        ("inf_vertex.obj", "not finite"),
+        ("index_out_of_range_negative.obj", "out of range"),
     ] {
         let err = Mesh::load_obj(&common::repo_path(&format!("tests/data/{file}"))).unwrap_err();
         assert_eq!(err.exit_code(), 2, "{file}");

@@ -7,6 +7,5 @@ layout(push_constant, std430) uniform ShadeConstants {
     vec4 light_toward;     // xyz: unit direction toward the light (directional) or position (point); w: 0 directional, 1 point
     vec4 light_irradiance; // rgb: irradiance at normal incidence (directional) or intensity (point)
     vec4 eye;              // xyz: camera position
-    vec4 albedo;           // rgb: diffuse albedo of the placeholder Lambert shading; a: ambient fraction
 } pc;
 #endif

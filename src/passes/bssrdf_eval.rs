@@ -92,14 +92,16 @@ impl BssrdfEvalPass {
     }
 }
 
+/// The model depends on xo − xi only: translate to xi = 0 in f64, so that two nearby points far
+/// from the origin keep their separation in f32.
 fn pack(q: &Query, diffusion: Diffusion) -> BssrdfQueryGpu {
     let v = |d: glam::DVec3| d.as_vec3().extend(0.0);
     BssrdfQueryGpu {
         channel: GpuChannel::from(&q.medium.constants(diffusion)),
-        xi: v(q.xi),
+        xi: Vec4::ZERO,
         ni: v(q.ni),
         wi: v(q.wi),
-        xo: v(q.xo),
+        xo: v(q.xo - q.xi),
         no: v(q.no),
     }
 }

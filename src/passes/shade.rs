@@ -1,5 +1,6 @@
-//! The shade pass: rasterises the mesh into the HDR colour target with depth.
-//! Reads: vertex and index buffers. Writes: colour and depth targets.
+//! The shade pass: rasterises the mesh and, per fragment, integrates the BSSRDF over the tree
+//! (shaders/shade.frag). Reads: vertices, indices, parameters, tree nodes, sorted points.
+//! Writes: colour and depth targets.
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec4};
@@ -7,7 +8,8 @@ use glam::{Mat4, Vec4};
 use crate::error::Result;
 use crate::scene::Light;
 use crate::vk::{
-    self, Buffer, Context, CullModeFlags, Format, GraphicsDesc, Image, Pipeline, PrimitiveTopology, Recorder,
+    self, Bind, BindingKind, Buffer, Context, CullModeFlags, Format, GraphicsDesc, Image, Pipeline, PrimitiveTopology,
+    Recorder,
 };
 
 pub const COLOR_FORMAT: Format = Format::R32G32B32A32_SFLOAT;
@@ -21,7 +23,20 @@ pub struct ShadeConstants {
     pub light_toward: Vec4,
     pub light_irradiance: Vec4,
     pub eye: Vec4,
-    pub albedo: Vec4,
+}
+
+/// Mirrors `SubsurfaceParams` in shaders/include/subsurface_params.glsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct SubsurfaceParams {
+    pub channels: [crate::physics::GpuChannel; 3],
+    pub mm_per_unit: f32,
+    pub epsilon: f32,
+    pub model: u32,
+    pub brute_force: u32,
+    pub point_count: u32,
+    pub node_count: u32,
+    pub pad: [u32; 2],
 }
 
 impl ShadeConstants {
@@ -30,13 +45,7 @@ impl ShadeConstants {
             Light::Directional { toward, irradiance } => (toward.normalize().extend(0.0), irradiance.extend(0.0)),
             Light::Point { position, intensity } => (position.extend(1.0), intensity.extend(0.0)),
         };
-        ShadeConstants {
-            view_projection,
-            light_toward: toward,
-            light_irradiance: irradiance,
-            eye: eye.extend(1.0),
-            albedo: Vec4::new(0.8, 0.8, 0.8, 0.05),
-        }
+        ShadeConstants { view_projection, light_toward: toward, light_irradiance: irradiance, eye: eye.extend(1.0) }
     }
 }
 
@@ -63,7 +72,7 @@ impl ShadePass {
                 depth_bias: false,
                 cull_mode: CullModeFlags::NONE,
                 additive_blend: false,
-                bindings: &[],
+                bindings: &[BindingKind::StorageBuffer, BindingKind::StorageBuffer, BindingKind::StorageBuffer],
                 push_constant_size: std::mem::size_of::<ShadeConstants>() as u32,
             },
         )?;
@@ -80,11 +89,16 @@ impl ShadePass {
         indices: &Buffer,
         index_count: u32,
         constants: &ShadeConstants,
+        params: &Buffer,
+        nodes: &Buffer,
+        points: &Buffer,
     ) -> Result<()> {
+        let binds = [Bind::Read(params), Bind::Read(nodes), Bind::Read(points)];
         rec.use_buffer(vertices, vk::Access::VERTEX_INPUT)?;
         rec.use_buffer(indices, vk::Access::INDEX_INPUT)?;
+        rec.prepare_draw_reads(&binds)?;
         rec.begin_rendering(&[(color, Some([0.0; 4]))], Some((depth, Some(1.0))), 0)?;
-        rec.draw(&self.pipeline, &[], vk::bytes_of(constants), Some(vertices), Some(indices), index_count, 1)?;
+        rec.draw(&self.pipeline, &binds, vk::bytes_of(constants), Some(vertices), Some(indices), index_count, 1)?;
         rec.end_rendering();
         Ok(())
     }
