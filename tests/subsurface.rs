@@ -63,3 +63,105 @@ fn tree_matches_brute_force_within_one_percent() {
         }
     }
 }
+
+/// A custom material with a short diffusion length (σa = 1, σs' = 2 per mm: 1/σtr = mfp = 1/3 mm),
+/// on a slab 8 × 8 × 2 mm (24 diffusion lengths wide), lit from `light_dir`, seen from straight
+/// above with a narrow field of view; returns the centre pixel's radiance (red channel).
+fn slab_centre(model: &str, light_dir: &str) -> f32 {
+    let light = format!("dir:{light_dir}:1");
+    let args = [
+        "--mesh",
+        "slab",
+        "--scale",
+        "2",
+        "--material",
+        "marble",
+        "--sigma-a",
+        "1",
+        "--sigma-s",
+        "2",
+        "--g",
+        "0",
+        "--eta",
+        "1.3",
+        "--model",
+        model,
+        "--light",
+        &light,
+        "--samples",
+        "80000",
+        "--eye",
+        "0,4,0",
+        "--target",
+        "0,0,0",
+        "--up",
+        "0,0,1",
+        "--fov",
+        "1",
+    ];
+    let path = output_dir().join(format!("slab-{model}-{}.exr", light_dir.replace(',', "_")));
+    let mut full = vec!["render", "--validation", "--width", "8", "--height", "8"];
+    full.extend_from_slice(&args);
+    full.extend_from_slice(&["--out", path.to_str().unwrap()]);
+    let out = translucent(&full);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let img = image::open(&path).unwrap().into_rgba32f();
+    let p = img.get_pixel(4, 4);
+    assert_eq!(p[3], 1.0);
+    p[0]
+}
+
+fn slab_medium() -> translucent::physics::Medium {
+    translucent::physics::Medium { sigma_a: 1.0, sigma_s: 2.0, g: 0.0, eta: 1.3 }
+}
+
+#[test]
+fn thick_slab_classical_dipole_equals_the_closed_form() {
+    use translucent::physics::{dipole, fresnel, Diffusion};
+    let c = slab_medium().constants(Diffusion::Classical);
+    let ft0 = fresnel::transmittance(1.3, 1.0);
+    let expected = ft0 * ft0 * dipole::total_rd(c.alpha_reduced, c.a_dipole) / std::f64::consts::PI;
+    let got = slab_centre("dipole", "0,1,0") as f64;
+    println!("classical dipole slab: {got:.6} vs E Ft² Rd/π = {expected:.6}");
+    assert!((got - expected).abs() <= 0.02 * expected);
+}
+
+/// ∫Sd dA over the plane y = 0 (normal +y) for light arriving from `toward` at the origin, exit
+/// at the origin: polar grid, log-spaced radii.
+fn dirpole_plane_integral(toward: glam::DVec3) -> f64 {
+    use glam::DVec3;
+    use translucent::physics::{dirpole, Diffusion};
+    let c = slab_medium().constants(Diffusion::Classical);
+    let n = DVec3::Y;
+    let (radii, angles) = (4000, 256);
+    let (lo, hi) = (1e-6f64.ln(), (40.0 / c.sigma_tr).ln());
+    let h = (hi - lo) / radii as f64;
+    let mut sum = 0.0;
+    for i in 0..radii {
+        let r = (lo + (i as f64 + 0.5) * h).exp();
+        let mut ring = 0.0;
+        for k in 0..angles {
+            let phi = (k as f64 + 0.5) * std::f64::consts::TAU / angles as f64;
+            // Entry point xi around the exit point xo = 0.
+            let xi = DVec3::new(r * phi.cos(), 0.0, r * phi.sin());
+            ring += dirpole::sd(&c, xi, n, toward, DVec3::ZERO, n);
+        }
+        sum += ring / angles as f64 * std::f64::consts::TAU * r * r * h;
+    }
+    sum
+}
+
+#[test]
+fn thick_slab_directional_dipole_equals_the_plane_integral() {
+    use glam::DVec3;
+    use translucent::physics::fresnel;
+    let ft0 = fresnel::transmittance(1.3, 1.0);
+    for (label, toward) in [("0,1,0", DVec3::Y), ("0.8660254,0.5,0", DVec3::new(0.866_025_4, 0.5, 0.0))] {
+        let cos_i = toward.y;
+        let irradiance_in = cos_i * fresnel::transmittance(1.3, cos_i);
+        let expected = ft0 * irradiance_in * dirpole_plane_integral(toward.normalize());
+        let got = slab_centre("directional", label) as f64;
+        println!("directional dipole slab, light {label}: {got:.6} vs {expected:.6}");
+        assert!((got - expected).abs() <= 0.02 * expected, "{label}: {got} vs {expected}");
+    }
+}
