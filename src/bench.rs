@@ -41,7 +41,7 @@ pub fn run(options: &BenchOptions) -> Result<String> {
                     material: crate::materials::Material::find("marble")?,
                     model: crate::physics::Model::Directional,
                     diffusion: crate::physics::Diffusion::Classical,
-                    epsilon: 0.05,
+                    epsilon: 0.1,
                     brute_force: false,
                 },
                 width: options.width,

@@ -253,8 +253,10 @@ pub struct RenderArgs {
     pub model: ModelArg,
     #[arg(long, value_enum, default_value = "classical")]
     pub diffusion: DiffusionArg,
-    /// Use a tree node as one source when its area / squared distance is below this.
-    #[arg(long, allow_hyphen_values = true, default_value_t = 0.05, value_parser = finite_f32)]
+    /// Use a tree node as one source when its area / squared distance is below this. Measured
+    /// against brute force (tests/subsurface.rs, 4096 points): relative RMSE 1.2% at 0.2, 0.45% at
+    /// 0.1, 0.15% at 0.05, 0.005% at 0.01; the shading time grows about 1.35× per halving.
+    #[arg(long, allow_hyphen_values = true, default_value_t = 0.1, value_parser = finite_f32)]
     pub epsilon: f32,
     /// Visit every sample point for every pixel (the reference for the tree).
     #[arg(long)]
@@ -384,7 +386,14 @@ fn bssrdf(args: &BssrdfArgs) -> Result<i32> {
         let counts = ctx.validation_counts();
         let validating = ctx.validation;
         let pass = crate::passes::bssrdf_eval::BssrdfEvalPass::new(&ctx)?;
+        let evaluation = std::time::Instant::now();
         let sd: Vec<f64> = pass.evaluate(&ctx, &queries, model, diffusion)?.into_iter().map(f64::from).collect();
+        let seconds = evaluation.elapsed().as_secs_f64();
+        log::info!(
+            "GPU: {} rows in {seconds:.3} s ({:.3e} evaluations/s, upload and read-back included)",
+            queries.len(),
+            queries.len() as f64 / seconds
+        );
         drop(pass);
         drop(ctx);
         (sd, validation_exit_code(validating, &counts))

@@ -50,6 +50,8 @@ impl ShadeConstants {
 }
 
 pub struct ShadePass {
+    /// Depth only, so that the expensive fragment shader runs once per pixel (EQUAL test).
+    depth_prepass: Pipeline,
     pipeline: Pipeline,
 }
 
@@ -69,6 +71,7 @@ impl ShadePass {
                 color_formats: &[COLOR_FORMAT],
                 depth_format: Some(DEPTH_FORMAT),
                 depth_test: true,
+                depth_equal: true,
                 depth_bias: false,
                 cull_mode: CullModeFlags::NONE,
                 additive_blend: false,
@@ -76,7 +79,26 @@ impl ShadePass {
                 push_constant_size: std::mem::size_of::<ShadeConstants>() as u32,
             },
         )?;
-        Ok(ShadePass { pipeline })
+        let depth_prepass = Pipeline::graphics(
+            ctx,
+            &GraphicsDesc {
+                vertex_shader: "hierarchy/shadow.vert",
+                fragment_shader: None,
+                vertex_stride: VERTEX_STRIDE,
+                vertex_attributes: &[(0, Format::R32G32B32_SFLOAT, 0)],
+                topology: PrimitiveTopology::TRIANGLE_LIST,
+                color_formats: &[],
+                depth_format: Some(DEPTH_FORMAT),
+                depth_test: true,
+                depth_equal: false,
+                depth_bias: false,
+                cull_mode: CullModeFlags::NONE,
+                additive_blend: false,
+                bindings: &[],
+                push_constant_size: 64,
+            },
+        )?;
+        Ok(ShadePass { depth_prepass, pipeline })
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -97,7 +119,11 @@ impl ShadePass {
         rec.use_buffer(vertices, vk::Access::VERTEX_INPUT)?;
         rec.use_buffer(indices, vk::Access::INDEX_INPUT)?;
         rec.prepare_draw_reads(&binds)?;
-        rec.begin_rendering(&[(color, Some([0.0; 4]))], Some((depth, Some(1.0))), 0)?;
+        rec.begin_rendering(&[], Some((depth, Some(1.0))), 0)?;
+        let matrix = constants.view_projection;
+        rec.draw(&self.depth_prepass, &[], vk::bytes_of(&matrix), Some(vertices), Some(indices), index_count, 1)?;
+        rec.end_rendering();
+        rec.begin_rendering(&[(color, Some([0.0; 4]))], Some((depth, None)), 0)?;
         rec.draw(&self.pipeline, &binds, vk::bytes_of(constants), Some(vertices), Some(indices), index_count, 1)?;
         rec.end_rendering();
         Ok(())

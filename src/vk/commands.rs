@@ -11,7 +11,7 @@ use ash::vk;
 use super::context::Context;
 use super::pipeline::{BindingKind, Pipeline};
 use super::profiler::GpuProfiler;
-use super::resources::{aspect_of, Access, Buffer, Image, Sampler};
+use super::resources::{aspect_of, Access, Buffer, Image, Sampler, Transition};
 use crate::error::Result;
 use crate::runtime;
 
@@ -161,15 +161,6 @@ impl Context {
         Ok(value)
     }
 }
-
-type Transition = (
-    vk::PipelineStageFlags2,
-    vk::AccessFlags2,
-    vk::PipelineStageFlags2,
-    vk::AccessFlags2,
-    vk::ImageLayout,
-    vk::ImageLayout,
-);
 
 impl<'a> Recorder<'a> {
     fn device(&self) -> &ash::Device {

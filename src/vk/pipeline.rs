@@ -221,8 +221,8 @@ impl Pipeline {
             vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
         let depth = vk::PipelineDepthStencilStateCreateInfo::default()
             .depth_test_enable(desc.depth_format.is_some() && desc.depth_test)
-            .depth_write_enable(desc.depth_format.is_some() && desc.depth_test)
-            .depth_compare_op(vk::CompareOp::LESS_OR_EQUAL);
+            .depth_write_enable(desc.depth_format.is_some() && desc.depth_test && !desc.depth_equal)
+            .depth_compare_op(if desc.depth_equal { vk::CompareOp::EQUAL } else { vk::CompareOp::LESS_OR_EQUAL });
         let blend_attachments: Vec<_> = desc
             .color_formats
             .iter()
@@ -302,6 +302,8 @@ pub struct GraphicsDesc<'a> {
     pub color_formats: &'a [vk::Format],
     pub depth_format: Option<vk::Format>,
     pub depth_test: bool,
+    /// Test depth for equality without writing it (shading after a depth pre-pass).
+    pub depth_equal: bool,
     pub depth_bias: bool,
     pub cull_mode: vk::CullModeFlags,
     pub additive_blend: bool,

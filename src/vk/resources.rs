@@ -132,6 +132,17 @@ impl Access {
     }
 }
 
+/// A barrier: (source stage, source access, destination stage, destination access, old layout,
+/// new layout).
+pub(crate) type Transition = (
+    vk::PipelineStageFlags2,
+    vk::AccessFlags2,
+    vk::PipelineStageFlags2,
+    vk::AccessFlags2,
+    vk::ImageLayout,
+    vk::ImageLayout,
+);
+
 /// What the recorder remembers about a resource between uses: the last write, and the reads that
 /// have already been made to see it (so repeated reads need no barrier).
 #[derive(Clone, Copy, Debug)]
@@ -148,18 +159,7 @@ impl TrackedState {
 
     /// The barrier `(src_stage, src_access, dst_stage, dst_access, old_layout, new_layout)` needed
     /// before `next`, or `None`; updates the state as if it was recorded.
-    pub(crate) fn transition(
-        &mut self,
-        next: Access,
-        is_image: bool,
-    ) -> Option<(
-        vk::PipelineStageFlags2,
-        vk::AccessFlags2,
-        vk::PipelineStageFlags2,
-        vk::AccessFlags2,
-        vk::ImageLayout,
-        vk::ImageLayout,
-    )> {
+    pub(crate) fn transition(&mut self, next: Access, is_image: bool) -> Option<Transition> {
         let layout_change = is_image && next.layout != self.layout;
         let old_layout = self.layout;
         if next.writes() || layout_change {
