@@ -70,6 +70,7 @@ pub struct Renderer {
     profiler: Option<GpuProfiler>,
     pub hierarchy: Hierarchy,
     subsurface_params: Buffer,
+    brute_force: bool,
     shade: ShadePass,
     debug_view: DebugViewPass,
     show: Show,
@@ -150,6 +151,7 @@ impl Renderer {
             profiler,
             hierarchy,
             subsurface_params,
+            brute_force: subsurface.brute_force,
             shade,
             debug_view: DebugViewPass::new(&ctx)?,
             show,
@@ -192,6 +194,7 @@ impl Renderer {
                 &self.subsurface_params,
                 &self.hierarchy.nodes,
                 &self.hierarchy.sorted_points,
+                self.brute_force.then_some(self.hierarchy.point_count),
             )?;
             rec.end_scope();
 

@@ -13,9 +13,10 @@ fn shade_constants_match_glsl() {
         offset_of!(ShadeConstants, light_toward) as u32,
         offset_of!(ShadeConstants, light_irradiance) as u32,
         offset_of!(ShadeConstants, eye) as u32,
+        offset_of!(ShadeConstants, point_range) as u32,
     ];
     assert_eq!(glsl, rust);
-    assert_eq!(size_of::<ShadeConstants>(), 112);
+    assert_eq!(size_of::<ShadeConstants>(), 128);
 }
 
 #[test]

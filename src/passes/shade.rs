@@ -23,7 +23,13 @@ pub struct ShadeConstants {
     pub light_toward: Vec4,
     pub light_irradiance: Vec4,
     pub eye: Vec4,
+    /// Brute force: first point and count of one draw; draws are added by blending.
+    pub point_range: glam::UVec4,
 }
+
+/// Points per brute-force draw: keeps every fragment invocation's loop short (llvmpipe ends loops
+/// after ~65k iterations; a real GPU's watchdog dislikes long draws too).
+pub const POINTS_PER_DRAW: u32 = 8192;
 
 /// Mirrors `SubsurfaceParams` in shaders/include/subsurface_params.glsl.
 #[repr(C)]
@@ -45,7 +51,13 @@ impl ShadeConstants {
             Light::Directional { toward, irradiance } => (toward.normalize().extend(0.0), irradiance.extend(0.0)),
             Light::Point { position, intensity } => (position.extend(1.0), intensity.extend(0.0)),
         };
-        ShadeConstants { view_projection, light_toward: toward, light_irradiance: irradiance, eye: eye.extend(1.0) }
+        ShadeConstants {
+            view_projection,
+            light_toward: toward,
+            light_irradiance: irradiance,
+            eye: eye.extend(1.0),
+            point_range: glam::UVec4::ZERO,
+        }
     }
 }
 
@@ -53,6 +65,8 @@ pub struct ShadePass {
     /// Depth only, so that the expensive fragment shader runs once per pixel (EQUAL test).
     depth_prepass: Pipeline,
     pipeline: Pipeline,
+    /// The same shader with additive blending, for brute force in several draws.
+    additive: Pipeline,
 }
 
 /// Bytes per vertex: position and normal, 3 floats each.
@@ -60,25 +74,29 @@ const VERTEX_STRIDE: u32 = 24;
 
 impl ShadePass {
     pub fn new(ctx: &Context) -> Result<ShadePass> {
-        let pipeline = Pipeline::graphics(
-            ctx,
-            &GraphicsDesc {
-                vertex_shader: "shade.vert",
-                fragment_shader: Some("shade.frag"),
-                vertex_stride: VERTEX_STRIDE,
-                vertex_attributes: &[(0, Format::R32G32B32_SFLOAT, 0), (1, Format::R32G32B32_SFLOAT, 12)],
-                topology: PrimitiveTopology::TRIANGLE_LIST,
-                color_formats: &[COLOR_FORMAT],
-                depth_format: Some(DEPTH_FORMAT),
-                depth_test: true,
-                depth_equal: true,
-                depth_bias: false,
-                cull_mode: CullModeFlags::NONE,
-                additive_blend: false,
-                bindings: &[BindingKind::StorageBuffer, BindingKind::StorageBuffer, BindingKind::StorageBuffer],
-                push_constant_size: std::mem::size_of::<ShadeConstants>() as u32,
-            },
-        )?;
+        let shading = |additive_blend: bool| {
+            Pipeline::graphics(
+                ctx,
+                &GraphicsDesc {
+                    vertex_shader: "shade.vert",
+                    fragment_shader: Some("shade.frag"),
+                    vertex_stride: VERTEX_STRIDE,
+                    vertex_attributes: &[(0, Format::R32G32B32_SFLOAT, 0), (1, Format::R32G32B32_SFLOAT, 12)],
+                    topology: PrimitiveTopology::TRIANGLE_LIST,
+                    color_formats: &[COLOR_FORMAT],
+                    depth_format: Some(DEPTH_FORMAT),
+                    depth_test: true,
+                    depth_equal: true,
+                    depth_bias: false,
+                    cull_mode: CullModeFlags::NONE,
+                    additive_blend,
+                    bindings: &[BindingKind::StorageBuffer, BindingKind::StorageBuffer, BindingKind::StorageBuffer],
+                    push_constant_size: std::mem::size_of::<ShadeConstants>() as u32,
+                },
+            )
+        };
+        let pipeline = shading(false)?;
+        let additive = shading(true)?;
         let depth_prepass = Pipeline::graphics(
             ctx,
             &GraphicsDesc {
@@ -98,7 +116,7 @@ impl ShadePass {
                 push_constant_size: 64,
             },
         )?;
-        Ok(ShadePass { depth_prepass, pipeline })
+        Ok(ShadePass { depth_prepass, pipeline, additive })
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -114,6 +132,7 @@ impl ShadePass {
         params: &Buffer,
         nodes: &Buffer,
         points: &Buffer,
+        brute_force_points: Option<u32>,
     ) -> Result<()> {
         let binds = [Bind::Read(params), Bind::Read(nodes), Bind::Read(points)];
         rec.use_buffer(vertices, vk::Access::VERTEX_INPUT)?;
@@ -124,7 +143,24 @@ impl ShadePass {
         rec.draw(&self.depth_prepass, &[], vk::bytes_of(&matrix), Some(vertices), Some(indices), index_count, 1)?;
         rec.end_rendering();
         rec.begin_rendering(&[(color, Some([0.0; 4]))], Some((depth, None)), 0)?;
-        rec.draw(&self.pipeline, &binds, vk::bytes_of(constants), Some(vertices), Some(indices), index_count, 1)?;
+        match brute_force_points {
+            None => rec.draw(
+                &self.pipeline,
+                &binds,
+                vk::bytes_of(constants),
+                Some(vertices),
+                Some(indices),
+                index_count,
+                1,
+            )?,
+            Some(total) => {
+                for first in (0..total.max(1)).step_by(POINTS_PER_DRAW as usize) {
+                    let mut c = *constants;
+                    c.point_range = glam::UVec4::new(first, POINTS_PER_DRAW, 0, 0);
+                    rec.draw(&self.additive, &binds, vk::bytes_of(&c), Some(vertices), Some(indices), index_count, 1)?;
+                }
+            }
+        }
         rec.end_rendering();
         Ok(())
     }
