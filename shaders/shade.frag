@@ -15,6 +15,8 @@ layout(location = 0) out vec4 radiance;
 layout(std430, binding = 0) readonly buffer Params { SubsurfaceParams params; };
 layout(std430, binding = 1) readonly buffer Nodes { TreeNode nodes[]; };
 layout(std430, binding = 2) readonly buffer Sorted { SurfacePoint points[]; };
+// Work per pixel for --profile: sums and maxima of nodes visited and points evaluated.
+layout(std430, binding = 3) buffer WorkCounters { uint pixels; uint node_sum; uint node_max; uint point_sum; uint point_max; } work;
 
 const uint STACK_SIZE = 96u;
 const uint MAX_VISITS = 16384u;
@@ -45,15 +47,17 @@ void main() {
     vec3 no = normalize(world_normal);
     vec3 wo = normalize(pc.eye.xyz - xo);
     vec3 sum = vec3(0.0);
+    uint visits = 0u;
+    uint evaluated = 0u;
     if (params.brute_force != 0u || params.node_count == 0u) {
         // One draw per range of points, added by blending: llvmpipe (lavapipe) silently ends a
         // shader invocation's loops after ~65k iterations in total, so no draw may loop longer.
         uint end = min(pc.point_range.x + pc.point_range.y, params.point_count);
         for (uint i = pc.point_range.x; i < end; ++i) sum += point_source(i, xo, no);
+        evaluated = end > pc.point_range.x ? end - pc.point_range.x : 0u;
     } else {
         uint stack[STACK_SIZE];
         uint top = 0u;
-        uint visits = 0u;
         stack[top++] = 0u;
         while (top > 0u) {
             TreeNode node = nodes[stack[--top]];
@@ -73,10 +77,28 @@ void main() {
             uint children[2] = uint[2](node.left, node.right);
             for (int k = 0; k < 2; ++k) {
                 uint child = children[k];
-                if ((child & LEAF_BIT) != 0u) sum += point_source(child & ~LEAF_BIT, xo, no);
-                else stack[top++] = child;
+                if ((child & LEAF_BIT) != 0u) {
+                    sum += point_source(child & ~LEAF_BIT, xo, no);
+                    ++evaluated;
+                } else {
+                    stack[top++] = child;
+                }
             }
         }
+    }
+    // Helper invocations' atomics have no effect (Vulkan spec), so only real pixels count.
+    if (params.count_work != 0u) {
+        // Brute-force draws after the first add their points only.
+        bool brute_force = params.brute_force != 0u || params.node_count == 0u;
+        if (pc.point_range.x == 0u) {
+            atomicAdd(work.pixels, 1u);
+            atomicAdd(work.node_sum, visits);
+            atomicMax(work.node_max, visits);
+            // A brute-force pixel's points span several draws: its maximum is all of them (the
+            // measured sum over the draws checks it).
+            atomicMax(work.point_max, brute_force ? params.point_count : evaluated);
+        }
+        atomicAdd(work.point_sum, evaluated);
     }
     float cos_o = max(dot(no, wo), 0.0);
     radiance = vec4(fresnel_transmittance(params.channels[0].eta, cos_o) * sum, 1.0);

@@ -541,6 +541,7 @@ fn render(args: &RenderArgs) -> Result<i32> {
         frames.push(renderer.render_frame(&scene)?);
     }
     let image = renderer.image()?;
+    let work = renderer.work()?;
     drop(renderer);
 
     let exposure = args.exposure.map(Exposure::Stops).unwrap_or(Exposure::Auto);
@@ -549,6 +550,17 @@ fn render(args: &RenderArgs) -> Result<i32> {
 
     if profiling && frames.iter().any(|f| !f.is_empty()) {
         report_profile(&device_name, frames, args)?;
+        if args.profile && work.pixels > 0 {
+            let per_pixel = |sum: u32| sum as f64 / work.pixels as f64;
+            println!(
+                "work per pixel (last frame, {} pixels): nodes visited mean {:.1} max {}, points evaluated mean {:.1} max {}",
+                work.pixels,
+                per_pixel(work.node_sum),
+                work.node_max,
+                per_pixel(work.point_sum),
+                work.point_max
+            );
+        }
     }
     Ok(validation_exit_code(validating, &counts))
 }

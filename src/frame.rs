@@ -7,7 +7,7 @@ use crate::hierarchy::{Hierarchy, HierarchyOptions};
 use crate::materials::Material;
 use crate::output::HdrImage;
 use crate::passes::debug_view::{self, DebugConstants, DebugViewPass};
-use crate::passes::shade::{self, ShadeConstants, ShadePass, SubsurfaceParams};
+use crate::passes::shade::{self, ShadeConstants, ShadePass, SubsurfaceParams, WorkCounters};
 use crate::physics::{Diffusion, GpuChannel, Model};
 use crate::scene::Scene;
 use crate::vk::{
@@ -28,7 +28,8 @@ fn subsurface_params(o: &SubsurfaceOptions, mm_per_unit: f32, point_count: u32) 
         brute_force: o.brute_force as u32,
         point_count,
         node_count: point_count - 1,
-        pad: [0; 2],
+        count_work: 0,
+        pad: 0,
     }
 }
 
@@ -70,6 +71,8 @@ pub struct Renderer {
     profiler: Option<GpuProfiler>,
     pub hierarchy: Hierarchy,
     subsurface_params: Buffer,
+    /// Nodes and points per pixel, counted on the GPU when profiling.
+    work_counters: Buffer,
     brute_force: bool,
     shade: ShadePass,
     debug_view: DebugViewPass,
@@ -138,7 +141,15 @@ impl Renderer {
             Buffer::new(&ctx, "readback", readback_bytes, BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)?;
         let shade = ShadePass::new(&ctx)?;
         let hierarchy = Hierarchy::new(&ctx, &scene.mesh, &scene.lights, &hierarchy)?;
-        let params = subsurface_params(&subsurface, scene.mm_per_unit, hierarchy.point_count);
+        let mut params = subsurface_params(&subsurface, scene.mm_per_unit, hierarchy.point_count);
+        params.count_work = (profile && ctx.has_fragment_atomics) as u32;
+        let work_counters = Buffer::new(
+            &ctx,
+            "work counters",
+            std::mem::size_of::<WorkCounters>() as u64,
+            BufferUsageFlags::STORAGE_BUFFER | BufferUsageFlags::TRANSFER_DST,
+            MemoryLocation::GpuToCpu,
+        )?;
         let mut subsurface_params = Buffer::new(
             &ctx,
             "subsurface parameters",
@@ -151,6 +162,7 @@ impl Renderer {
             profiler,
             hierarchy,
             subsurface_params,
+            work_counters,
             brute_force: subsurface.brute_force,
             shade,
             debug_view: DebugViewPass::new(&ctx)?,
@@ -194,6 +206,7 @@ impl Renderer {
                 &self.subsurface_params,
                 &self.hierarchy.nodes,
                 &self.hierarchy.sorted_points,
+                &self.work_counters,
                 self.brute_force.then_some(self.hierarchy.point_count),
             )?;
             rec.end_scope();
@@ -229,11 +242,18 @@ impl Renderer {
         }
         self.ctx.submit(self.profiler.as_mut(), |rec| {
             rec.begin_scope("readback");
+            rec.host_read(&self.work_counters)?;
             rec.copy_image_to_buffer(&self.color, &self.readback)?;
             rec.end_scope();
             Ok(())
         })?;
         Ok(self.profiler.as_mut().map(|p| p.take_scopes()).unwrap_or_default())
+    }
+
+    /// Work of the last frame's shading per pixel (zeros unless profiling on a device with
+    /// fragment-shader atomics).
+    pub fn work(&self) -> Result<WorkCounters> {
+        Ok(self.work_counters.read::<WorkCounters>(1)?[0])
     }
 
     /// The last frame's linear radiance, read back from the GPU.

@@ -173,3 +173,36 @@ fn thick_slab_directional_dipole_equals_the_plane_integral() {
         assert!((got - expected).abs() <= 0.02 * expected, "{label}: {got} vs {expected}");
     }
 }
+
+/// `--profile` reports the work per pixel counted on the GPU: brute force evaluates every point at
+/// every pixel, the tree far fewer.
+#[test]
+fn profile_counts_work_per_pixel() {
+    let run = |extra: &[&str]| {
+        let path = output_dir().join("work.png");
+        let mut args =
+            vec!["render", "--validation", "--width", "16", "--height", "16", "--samples", "10000", "--profile"];
+        args.extend_from_slice(extra);
+        args.extend_from_slice(&["--out", path.to_str().unwrap()]);
+        let out = translucent(&args);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let text = String::from_utf8_lossy(&out.stdout).into_owned();
+        let line = text
+            .lines()
+            .find(|l| l.starts_with("work per pixel"))
+            .unwrap_or_else(|| panic!("no work line in:\n{text}"))
+            .to_string();
+        let numbers: Vec<f64> =
+            line.split(|c: char| !(c.is_ascii_digit() || c == '.')).filter_map(|w| w.parse().ok()).collect();
+        // [pixels, node mean, node max, point mean, point max]
+        (line, numbers)
+    };
+    let (line, brute) = run(&["--brute-force"]);
+    println!("{line}");
+    assert!(brute[0] > 50.0, "the sphere covers pixels");
+    assert_eq!((brute[3], brute[4]), (10000.0, 10000.0), "brute force evaluates every point once per pixel");
+    let (line, tree) = run(&[]);
+    println!("{line}");
+    assert!(tree[1] > 1.0 && tree[2] >= tree[1], "nodes visited: {tree:?}");
+    assert!(tree[3] < 0.2 * 10000.0, "the tree must evaluate far fewer points than brute force: {tree:?}");
+}

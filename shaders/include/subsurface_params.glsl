@@ -10,7 +10,7 @@ struct SubsurfaceParams {
     uint brute_force;          // 1: every point, no tree
     uint point_count;
     uint node_count;
-    uint pad0;
+    uint count_work;           // 1: add this pixel's work to the counters (--profile)
     uint pad1;
 };
 #endif

@@ -42,7 +42,20 @@ pub struct SubsurfaceParams {
     pub brute_force: u32,
     pub point_count: u32,
     pub node_count: u32,
-    pub pad: [u32; 2],
+    /// 1 to count the work per pixel (nodes visited, points evaluated) for `--profile`.
+    pub count_work: u32,
+    pub pad: u32,
+}
+
+/// Mirrors `WorkCounters` in shaders/shade.frag.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct WorkCounters {
+    pub pixels: u32,
+    pub node_sum: u32,
+    pub node_max: u32,
+    pub point_sum: u32,
+    pub point_max: u32,
 }
 
 impl ShadeConstants {
@@ -90,7 +103,7 @@ impl ShadePass {
                     depth_bias: false,
                     cull_mode: CullModeFlags::NONE,
                     additive_blend,
-                    bindings: &[BindingKind::StorageBuffer, BindingKind::StorageBuffer, BindingKind::StorageBuffer],
+                    bindings: &[BindingKind::StorageBuffer; 4],
                     push_constant_size: std::mem::size_of::<ShadeConstants>() as u32,
                 },
             )
@@ -132,9 +145,11 @@ impl ShadePass {
         params: &Buffer,
         nodes: &Buffer,
         points: &Buffer,
+        work: &Buffer,
         brute_force_points: Option<u32>,
     ) -> Result<()> {
-        let binds = [Bind::Read(params), Bind::Read(nodes), Bind::Read(points)];
+        rec.fill_buffer(work, 0)?;
+        let binds = [Bind::Read(params), Bind::Read(nodes), Bind::Read(points), Bind::Write(work)];
         rec.use_buffer(vertices, vk::Access::VERTEX_INPUT)?;
         rec.use_buffer(indices, vk::Access::INDEX_INPUT)?;
         rec.prepare_draw_reads(&binds)?;
@@ -142,26 +157,27 @@ impl ShadePass {
         let matrix = constants.view_projection;
         rec.draw(&self.depth_prepass, &[], vk::bytes_of(&matrix), Some(vertices), Some(indices), index_count, 1)?;
         rec.end_rendering();
-        rec.begin_rendering(&[(color, Some([0.0; 4]))], Some((depth, None)), 0)?;
         match brute_force_points {
-            None => rec.draw(
-                &self.pipeline,
-                &binds,
-                vk::bytes_of(constants),
-                Some(vertices),
-                Some(indices),
-                index_count,
-                1,
-            )?,
+            None => {
+                rec.begin_rendering(&[(color, Some([0.0; 4]))], Some((depth, None)), 0)?;
+                let c = vk::bytes_of(constants);
+                rec.draw(&self.pipeline, &binds, c, Some(vertices), Some(indices), index_count, 1)?;
+                rec.end_rendering();
+            }
             Some(total) => {
+                // One rendering scope per draw: every draw writes the work counters, and the
+                // barrier between two writes cannot sit inside a rendering scope.
                 for first in (0..total.max(1)).step_by(POINTS_PER_DRAW as usize) {
+                    let clear = (first == 0).then_some([0.0; 4]);
                     let mut c = *constants;
                     c.point_range = glam::UVec4::new(first, POINTS_PER_DRAW, 0, 0);
+                    rec.prepare_draw_reads(&binds)?;
+                    rec.begin_rendering(&[(color, clear)], Some((depth, None)), 0)?;
                     rec.draw(&self.additive, &binds, vk::bytes_of(&c), Some(vertices), Some(indices), index_count, 1)?;
+                    rec.end_rendering();
                 }
             }
         }
-        rec.end_rendering();
         Ok(())
     }
 }

@@ -275,8 +275,12 @@ impl<'a> Recorder<'a> {
                     pipeline.name
                 ));
             }
+            // Inside a rendering scope, a write declared before begin_rendering (with
+            // prepare_draw_reads) is already ordered: re-declaring it is not a new hazard.
+            let declared_write = |b: &Buffer| self.inside_rendering && b.state.get().last_write == stage.write();
             match bind {
                 Bind::Read(b) => self.use_buffer(b, stage.read())?,
+                Bind::Write(b) if declared_write(b) => {}
                 Bind::Write(b) => self.use_buffer(b, stage.write())?,
                 Bind::Uniform(b) => self.use_buffer(b, Access { stage: stage.flags(), ..Access::UNIFORM_READ })?,
                 Bind::Sampled(img, _) => self.use_image(img, stage.sampled())?,
