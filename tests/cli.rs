@@ -8,7 +8,8 @@ use common::{repo_path, stderr, translucent};
 /// Runs `render` with `args` and asserts exit code 2 and an `error:` line containing `needle`.
 fn assert_bad_input(args: &[&str], needle: &str) {
     let out = common::output_dir().join("bad-input.png");
-    let mut full = vec!["render", "--out", out.to_str().unwrap()];
+    // Validation on: several of these cases create a device before they are refused.
+    let mut full = vec!["render", "--validation", "--out", out.to_str().unwrap()];
     // Small images unless the case is about the size itself.
     for flag in ["--width", "--height"] {
         if !args.contains(&flag) {
@@ -65,7 +66,7 @@ fn bad_flag_values() {
 
 #[test]
 fn bad_output_extension() {
-    let result = translucent(&["render", "--width", "8", "--height", "8", "--out", "picture.bmp"]);
+    let result = translucent(&["render", "--validation", "--width", "8", "--height", "8", "--out", "picture.bmp"]);
     assert_eq!(result.status.code(), Some(2));
     assert!(stderr(&result).contains("picture.bmp"));
 }

@@ -98,7 +98,7 @@ fn bssrdf_handles_100k_rows_quickly() {
             f(q.no)
         );
     }
-    for args in [&[][..], &["--gpu"][..]] {
+    for args in [&[][..], &["--gpu", "--validation"][..]] {
         let start = std::time::Instant::now();
         let out = bssrdf(args, &input);
         assert!(out.status.success(), "{}", stderr(&out));
