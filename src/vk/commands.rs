@@ -275,18 +275,7 @@ impl<'a> Recorder<'a> {
                     pipeline.name
                 ));
             }
-            // Inside a rendering scope, a write declared before begin_rendering (with
-            // prepare_draw_reads) is already ordered: re-declaring it is not a new hazard.
-            let declared_write = |b: &Buffer| self.inside_rendering && b.state.get().last_write == stage.write();
-            match bind {
-                Bind::Read(b) => self.use_buffer(b, stage.read())?,
-                Bind::Write(b) if declared_write(b) => {}
-                Bind::Write(b) => self.use_buffer(b, stage.write())?,
-                Bind::Uniform(b) => self.use_buffer(b, Access { stage: stage.flags(), ..Access::UNIFORM_READ })?,
-                Bind::Sampled(img, _) => self.use_image(img, stage.sampled())?,
-                Bind::StorageImageRead(img) => self.use_image(img, stage.read())?,
-                Bind::StorageImageWrite(img) => self.use_image(img, stage.write())?,
-            }
+            self.declare(bind, stage)?;
         }
         let device = self.ctx.device();
         if !binds.is_empty() {
@@ -510,19 +499,26 @@ impl<'a> Recorder<'a> {
         Ok(())
     }
 
-    /// Declares the reads of a later draw before its rendering scope begins.
+    /// Declares the resources of a later draw before its rendering scope begins (barriers cannot
+    /// be recorded inside one).
     pub fn prepare_draw_reads(&mut self, binds: &[Bind]) -> Result<()> {
-        for bind in binds {
-            match bind {
-                Bind::Read(b) => self.use_buffer(b, Stage::Graphics.read())?,
-                Bind::Write(b) => self.use_buffer(b, Stage::Graphics.write())?,
-                Bind::Uniform(b) => self.use_buffer(b, Access::UNIFORM_READ)?,
-                Bind::Sampled(img, _) => self.use_image(img, Stage::Graphics.sampled())?,
-                Bind::StorageImageRead(img) => self.use_image(img, Stage::Graphics.read())?,
-                Bind::StorageImageWrite(img) => self.use_image(img, Stage::Graphics.write())?,
-            }
+        binds.iter().try_for_each(|bind| self.declare(bind, Stage::Graphics))
+    }
+
+    /// Declares how the shaders of `stage` use a bound resource, recording a barrier if needed.
+    fn declare(&mut self, bind: &Bind, stage: Stage) -> Result<()> {
+        // Inside a rendering scope, a write declared before begin_rendering (prepare_draw_reads)
+        // is already ordered: declaring it again for the draw is not a new hazard.
+        let declared_write = |b: &Buffer| self.inside_rendering && b.state.get().last_write == stage.write();
+        match bind {
+            Bind::Read(b) => self.use_buffer(b, stage.read()),
+            Bind::Write(b) if declared_write(b) => Ok(()),
+            Bind::Write(b) => self.use_buffer(b, stage.write()),
+            Bind::Uniform(b) => self.use_buffer(b, Access { stage: stage.flags(), ..Access::UNIFORM_READ }),
+            Bind::Sampled(img, _) => self.use_image(img, stage.sampled()),
+            Bind::StorageImageRead(img) => self.use_image(img, stage.read()),
+            Bind::StorageImageWrite(img) => self.use_image(img, stage.write()),
         }
-        Ok(())
     }
 
     pub fn copy_buffer(&mut self, src: &Buffer, dst: &Buffer, bytes: u64) -> Result<()> {
