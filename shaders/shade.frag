@@ -2,11 +2,14 @@
 // Subsurface scattering per pixel: walks the Jensen–Buhler tree from the root with an explicit
 // stack; a node far and small enough (area / distance² < epsilon, and xo outside its box) is one
 // source at its power centre, otherwise its children are visited; points are evaluated singly.
-// Lo(xo, wo) = Ft(eta, wo) · Σ Sd(xi, wi; xo, no) · power_i, power = E·A (mm²).
+// Lo(xo, wo) = Ft(eta, wo) · Σ Sd(xi, wi; xo, no) · power_i, power = E·A (mm²), plus the surface's
+// own reflection from each light: a microfacet lobe, shadowed by the same shadow maps.
 #include "common.glsl"
 #include "shade_constants.glsl"
 #include "points.glsl"
 #include "subsurface_params.glsl"
+#include "lights.glsl"
+#include "microfacet.glsl"
 
 layout(location = 0) in vec3 world_position;
 layout(location = 1) in vec3 world_normal;
@@ -17,6 +20,8 @@ layout(std430, binding = 1) readonly buffer Nodes { TreeNode nodes[]; };
 layout(std430, binding = 2) readonly buffer Sorted { SurfacePoint points[]; };
 // Work per pixel for --profile: sums and maxima of nodes visited and points evaluated.
 layout(std430, binding = 3) buffer WorkCounters { uint pixels; uint node_sum; uint node_max; uint point_sum; uint point_max; } work;
+layout(std430, binding = 4) readonly buffer Lights { LightSet light_set; mat4 layer_matrices[]; };
+layout(binding = 5) uniform sampler2DArrayShadow shadow_map;
 
 const uint STACK_SIZE = 96u;
 const uint MAX_VISITS = 16384u;
@@ -40,6 +45,23 @@ vec3 point_source(uint i, vec3 xo, vec3 no) {
     SurfacePoint p = points[i];
     if (p.irradiance == vec3(0.0)) return vec3(0.0);
     return source(p.position, p.normal, p.light_dir, p.irradiance * p.area, xo, no);
+}
+
+// Σ over lights of f_spec(wi, wo) · E · cos θi · visibility.
+vec3 specular(vec3 xo, vec3 no, vec3 wo) {
+    vec3 sum = vec3(0.0);
+    for (uint k = 0u; k < light_set.light_count; ++k) {
+        vec3 toward;
+        uint layer;
+        vec3 incident = light_at(light_set.lights[k], xo, toward, layer);
+        float f_cos = microfacet_reflect_cos(no, toward, wo, params.roughness, params.channels[0].eta);
+        if (f_cos <= 0.0) continue;
+        vec4 clip = layer_matrices[layer] * vec4(xo + no * light_set.normal_offset, 1.0);
+        vec3 ndc = clip.xyz / clip.w;
+        float visibility = texture(shadow_map, vec4(ndc.xy * 0.5 + 0.5, float(layer), ndc.z));
+        sum += f_cos * incident * visibility;
+    }
+    return sum;
 }
 
 void main() {
@@ -101,5 +123,8 @@ void main() {
         atomicAdd(work.point_sum, evaluated);
     }
     float cos_o = max(dot(no, wo), 0.0);
-    radiance = vec4(fresnel_transmittance(params.channels[0].eta, cos_o) * sum, 1.0);
+    vec3 lo = fresnel_transmittance(params.channels[0].eta, cos_o) * sum;
+    // The lobe is added once: by the first of several brute-force draws.
+    if (params.specular != 0u && pc.point_range.x == 0u) lo += specular(xo, no, wo);
+    radiance = vec4(lo, 1.0);
 }

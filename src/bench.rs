@@ -43,10 +43,13 @@ pub fn run(options: &BenchOptions) -> Result<String> {
                     diffusion: crate::physics::Diffusion::Classical,
                     epsilon: 0.1,
                     brute_force: false,
+                    specular: true,
+                    roughness: 0.35,
                 },
                 width: options.width,
                 height: options.height,
                 profile: true,
+                count_work: false,
                 hierarchy: HierarchyOptions { point_count: n, shadow_resolution: 1024, eta: 1.3 },
                 show: Show::Shading,
             };

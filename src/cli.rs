@@ -196,19 +196,26 @@ impl DeviceArgs {
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
-    /// Mesh: `sphere`, `box`, `slab`, `torus`, or the path of an OBJ file.
-    #[arg(long, default_value = "sphere")]
-    pub mesh: String,
-    /// Output image; the extension picks the format (.png or .exr).
+    /// Mesh: `sphere`, `box`, `slab`, `torus`, or the path of an OBJ file (default: the Stanford
+    /// bunny from glmark2-data when installed, else the sphere).
+    #[arg(long)]
+    pub mesh: Option<String>,
+    /// Output image; the extension picks the format (.png or .exr). A `{frame}` in the name
+    /// writes every frame, numbered from 0000.
     #[arg(long, short, default_value = "out.png")]
     pub out: PathBuf,
     #[arg(long, allow_hyphen_values = true, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..))]
     pub width: u32,
     #[arg(long, allow_hyphen_values = true, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..))]
     pub height: u32,
-    /// Frames to render (for timing; the image is the last frame).
+    /// Frames to render, each rebuilding the point cloud and tree (the image is the last frame,
+    /// or every frame with `{frame}` in --out).
     #[arg(long, allow_hyphen_values = true, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100_000))]
     pub frames: u32,
+    /// Turn the lights by this many degrees about the vertical axis (--up, through the mesh's
+    /// centre) every frame: a turntable of light.
+    #[arg(long, allow_hyphen_values = true, default_value_t = 0.0, value_parser = finite_f32, value_name = "DEG")]
+    pub spin_light: f32,
     /// Millimetres per scene unit (materials are given per mm).
     #[arg(long, allow_hyphen_values = true, default_value_t = 10.0, value_parser = positive_f32)]
     pub scale: f32,
@@ -223,8 +230,9 @@ pub struct RenderArgs {
     /// Vertical field of view in degrees.
     #[arg(long, allow_hyphen_values = true, default_value_t = 40.0, value_parser = finite_f32)]
     pub fov: f32,
-    /// Direction toward the directional light.
-    #[arg(long, allow_hyphen_values = true, value_parser = vec3, value_name = "X,Y,Z", default_value = "-0.5,0.8,0.6")]
+    /// Direction toward the directional light (default: behind and above the object, as the
+    /// default camera sees it, so that light shines through thin parts).
+    #[arg(long, allow_hyphen_values = true, value_parser = vec3, value_name = "X,Y,Z", default_value = "-0.3,0.7,-0.65")]
     pub light_dir: Vec3,
     /// Irradiance at normal incidence: one value or R,G,B.
     #[arg(long, allow_hyphen_values = true, value_parser = rgb, value_name = "I|R,G,B", default_value = "1")]
@@ -261,10 +269,17 @@ pub struct RenderArgs {
     /// Visit every sample point for every pixel (the reference for the tree).
     #[arg(long)]
     pub brute_force: bool,
+    /// Leave out the surface's own (microfacet) reflection: subsurface scattering alone.
+    #[arg(long)]
+    pub no_specular: bool,
+    /// Roughness of the microfacet reflection, in (0, 1] (GGX α = roughness²).
+    #[arg(long, allow_hyphen_values = true, default_value_t = 0.35, value_parser = finite_f32)]
+    pub roughness: f32,
     /// Exposure in stops (default: automatic from the image).
     #[arg(long, allow_hyphen_values = true, value_parser = finite_f32)]
     pub exposure: Option<f32>,
-    /// Print per-pass GPU times (mean, min, max, share of the frame).
+    /// Also count the shading work per pixel on the GPU (nodes visited, points evaluated). The
+    /// per-pass GPU times (mean, min, max, share of the frame) are always printed.
     #[arg(long)]
     pub profile: bool,
     /// Write the GPU timings as Chrome trace-event JSON (opens in Perfetto / chrome://tracing).
@@ -354,7 +369,7 @@ pub fn run(cli: Cli) -> Result<i32> {
         Command::Bssrdf(args) => bssrdf(&args),
         Command::Profile(args) => profile(&args),
         Command::Bench(args) => {
-            let bunny = "/usr/share/glmark2/models/bunny.obj";
+            let bunny = BUNNY;
             let meshes = args.meshes.clone().unwrap_or_else(|| {
                 let mut m = vec!["sphere".to_string()];
                 if std::path::Path::new(bunny).exists() {
@@ -458,8 +473,20 @@ fn devices() -> Result<i32> {
     Ok(0)
 }
 
+/// The Stanford bunny of Debian's glmark2-data, the default mesh when installed.
+pub const BUNNY: &str = "/usr/share/glmark2/models/bunny.obj";
+
+/// `--mesh`, or the default: the bunny when installed, else the sphere.
+pub fn mesh_spec(args: &RenderArgs) -> String {
+    match &args.mesh {
+        Some(m) => m.clone(),
+        None if std::path::Path::new(BUNNY).exists() => BUNNY.to_string(),
+        None => "sphere".to_string(),
+    }
+}
+
 pub fn build_scene(args: &RenderArgs) -> Result<Scene> {
-    let mesh = Mesh::from_spec(&args.mesh)?;
+    let mesh = Mesh::from_spec(&mesh_spec(args))?;
     let (centre, radius) = crate::scene::bounding_sphere(&mesh.positions);
     let mut camera = Camera::framing(centre, radius, args.fov, Vec3::new(0.3, 0.3, 1.0));
     camera.up = args.up;
@@ -494,20 +521,27 @@ fn check_output_path(path: &std::path::Path, flag: &str, allowed: &[&str]) -> Re
     Ok(())
 }
 
+/// `--out` for frame `index`: `{frame}` replaced by the zero-padded number.
+fn frame_path(out: &std::path::Path, index: u32) -> PathBuf {
+    PathBuf::from(out.to_string_lossy().replace("{frame}", &format!("{index:04}")))
+}
+
 fn render(args: &RenderArgs) -> Result<i32> {
     // Check everything the user typed before the (slow) device start.
     check_output_path(&args.out, "--out", &["png", "exr"])?;
     if let Some(p) = &args.profile_out {
         check_output_path(p, "--profile-out", &["json"])?;
     }
-    let scene = build_scene(args)?;
+    if !(args.roughness > 0.0 && args.roughness <= 1.0) {
+        return Err(bad_input!("--roughness {}: must be in (0, 1]", args.roughness));
+    }
+    let mut scene = build_scene(args)?;
+    let material = args.material.material()?;
     let ctx = Context::new(&args.device.options())?;
     let counts = ctx.validation_counts();
     let validating = ctx.validation;
-    let profiling = args.profile || args.profile_out.is_some();
     let device_name = format!("{} ({})", ctx.info.name, ctx.info.driver);
 
-    let material = args.material.material()?;
     let eta = material.eta as f32;
     let point_count = match args.samples {
         Some(n) => {
@@ -528,60 +562,86 @@ fn render(args: &RenderArgs) -> Result<i32> {
             diffusion: args.diffusion.into(),
             epsilon: args.epsilon,
             brute_force: args.brute_force,
+            specular: !args.no_specular,
+            roughness: args.roughness,
         },
         width: args.width,
         height: args.height,
-        profile: profiling,
+        profile: true,
+        count_work: args.profile,
         hierarchy: HierarchyOptions { point_count, shadow_resolution: args.shadow_resolution, eta },
         show,
     };
     let mut renderer = Renderer::new(ctx, &scene, options)?;
+    // A progress bar over every shading tile of every frame; indicatif hides it off a terminal.
+    let bar = indicatif::ProgressBar::new(args.frames as u64 * renderer.shading_units() as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} tiles, {eta} left")
+            .map_err(|e| runtime!("progress bar: {e}"))?
+            .progress_chars("=> "),
+    );
+    renderer.progress = Some(bar.clone());
+
+    let exposure = args.exposure.map(Exposure::Stops).unwrap_or(Exposure::Auto);
+    let every_frame = args.out.to_string_lossy().contains("{frame}");
+    let base_lights = scene.lights.clone();
+    let (centre, _) = crate::scene::bounding_sphere(&scene.mesh.positions);
     let mut frames = Vec::new();
-    for _ in 0..args.frames {
+    for index in 0..args.frames {
+        let angle = (args.spin_light * index as f32).to_radians();
+        scene.lights = base_lights.iter().map(|l| l.rotated(args.up, angle, centre)).collect();
         frames.push(renderer.render_frame(&scene)?);
+        if every_frame {
+            let path = frame_path(&args.out, index);
+            output::write_image(&path, &renderer.image()?, exposure)?;
+            bar.suspend(|| eprintln!("wrote {}", path.display()));
+        }
     }
+    bar.finish_and_clear();
     let image = renderer.image()?;
     let work = renderer.work()?;
     drop(renderer);
 
-    let exposure = args.exposure.map(Exposure::Stops).unwrap_or(Exposure::Auto);
-    output::write_image(&args.out, &image, exposure)?;
-    eprintln!("wrote {} ({}x{}, {} frame(s))", args.out.display(), args.width, args.height, args.frames);
+    if !every_frame {
+        output::write_image(&args.out, &image, exposure)?;
+        eprintln!("wrote {} ({}x{}, {} frame(s))", args.out.display(), args.width, args.height, args.frames);
+    }
 
-    if profiling && frames.iter().any(|f| !f.is_empty()) {
+    if frames.iter().any(|f| !f.is_empty()) {
         report_profile(&device_name, frames, args)?;
-        if args.profile && work.pixels > 0 {
-            let per_pixel = |sum: u32| sum as f64 / work.pixels as f64;
-            println!(
-                "work per pixel (last frame, {} pixels): nodes visited mean {:.1} max {}, points evaluated mean {:.1} max {}",
-                work.pixels,
-                per_pixel(work.node_sum),
-                work.node_max,
-                per_pixel(work.point_sum),
-                work.point_max
-            );
-        }
+    }
+    if args.profile && work.pixels > 0 {
+        let per_pixel = |sum: u32| sum as f64 / work.pixels as f64;
+        println!(
+            "work per pixel (last frame, {} pixels): nodes visited mean {:.1} max {}, points evaluated mean {:.1} max {}",
+            work.pixels,
+            per_pixel(work.node_sum),
+            work.node_max,
+            per_pixel(work.point_sum),
+            work.point_max
+        );
     }
     Ok(validation_exit_code(validating, &counts))
 }
 
-/// Sample count from the material's shortest diffusion length 1/σtr and the mesh's area (in mm),
-/// within a budget; prints the choice and warns when points are farther apart than 1/σtr.
+/// Sample count from the material's shortest length scale (mean free path 1/σ't or diffusion
+/// length 1/σtr) and the mesh's area (in mm), within a budget; prints the choice and warns when
+/// points are farther apart than that length.
 fn default_point_count(ctx: &Context, scene: &Scene, material: &Material) -> u32 {
     let mm = scene.mm_per_unit;
     let area_mm2 = scene.mesh.surface_area() * mm * mm;
     let shortest = (0..3)
         .map(|ch| material.channel(ch).constants(Diffusion::Classical))
         .filter(|c| c.transports && c.sigma_tr > 0.0)
-        .map(|c| 1.0 / c.sigma_tr)
+        .map(|c| (1.0 / c.sigma_tr).min(1.0 / c.sigma_t_reduced))
         .fold(f64::INFINITY, f64::min) as f32;
     let budget = crate::hierarchy::max_points(ctx).min(1 << 18);
     let (n, spacing) = crate::hierarchy::choose_point_count(area_mm2, shortest, budget);
     eprintln!(
-        "samples: {n} points, {spacing:.3} mm apart on {area_mm2:.0} mm² (shortest diffusion length 1/σtr = {shortest:.3} mm)"
+        "samples: {n} points, {spacing:.3} mm apart on {area_mm2:.0} mm² (shortest of mean free path and diffusion length: {shortest:.3} mm)"
     );
     if spacing > shortest {
-        eprintln!("warning: points are spaced wider than the diffusion length; raise --samples for accuracy");
+        eprintln!("warning: points are spaced wider than the mean free path or diffusion length; raise --samples for accuracy");
     }
     n
 }
@@ -595,9 +655,7 @@ fn report_profile(device: &str, frames: Vec<Vec<vk::TimedScope>>, args: &RenderA
             .map(|f| f.into_iter().map(|s| Scope { name: s.name, begin_ns: s.begin_ns, end_ns: s.end_ns }).collect())
             .collect(),
     };
-    if args.profile {
-        print!("{}", crate::profiling::format_table(&report));
-    }
+    print!("{}", crate::profiling::format_table(&report));
     if let Some(path) = &args.profile_out {
         std::fs::write(path, crate::profiling::chrome_trace_json(&report))
             .map_err(|e| runtime!("--profile-out {}: {e}", path.display()))?;

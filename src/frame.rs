@@ -2,18 +2,18 @@
 
 use glam::Vec3;
 
+use crate::bad_input;
 use crate::error::Result;
 use crate::hierarchy::{Hierarchy, HierarchyOptions};
 use crate::materials::Material;
 use crate::output::HdrImage;
 use crate::passes::debug_view::{self, DebugConstants, DebugViewPass};
-use crate::passes::shade::{self, ShadeConstants, ShadePass, SubsurfaceParams, WorkCounters};
+use crate::passes::shade::{self, ShadeConstants, ShadeInputs, ShadePass, SubsurfaceParams, WorkCounters};
 use crate::physics::{Diffusion, GpuChannel, Model};
 use crate::scene::Scene;
 use crate::vk::{
     self, Buffer, BufferUsageFlags, Context, Extent2D, GpuProfiler, Image, ImageUsageFlags, MemoryLocation, TimedScope,
 };
-use crate::{bad_input, runtime};
 
 fn subsurface_params(o: &SubsurfaceOptions, mm_per_unit: f32, point_count: u32) -> SubsurfaceParams {
     let channel = |c: usize| GpuChannel::from(&o.material.channel(c).constants(o.diffusion));
@@ -29,12 +29,22 @@ fn subsurface_params(o: &SubsurfaceOptions, mm_per_unit: f32, point_count: u32) 
         point_count,
         node_count: point_count - 1,
         count_work: 0,
-        pad: 0,
+        specular: o.specular as u32,
+        roughness: o.roughness,
+        pad: [0; 3],
     }
 }
 
-/// The most timestamp scopes one frame may open.
-const MAX_SCOPES: u32 = 64;
+/// The most timestamp scopes one frame may open (each shading submission opens one).
+const MAX_SCOPES: u32 = 4096;
+
+/// Shading is cut into tiles of this many pixels square (and, for brute force, ranges of points).
+const TILE: u32 = 128;
+
+/// Each shading submission takes as many tiles as fit in about this much time, learnt from the
+/// submissions before: short enough for GPU watchdogs (about 2 s on desktop drivers) and for a
+/// moving progress bar, while a fast GPU still shades a frame in one or two submissions.
+const SUBMISSION_TARGET_S: f64 = 0.2;
 
 /// What to draw over the shaded mesh for debugging.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -55,13 +65,20 @@ pub struct SubsurfaceOptions {
     pub epsilon: f32,
     /// Sum over every point instead of walking the tree (the reference).
     pub brute_force: bool,
+    /// Add the surface's microfacet reflection (`--no-specular` turns it off).
+    pub specular: bool,
+    /// Roughness of the microfacet lobe (α = roughness²), in (0, 1].
+    pub roughness: f32,
 }
 
 pub struct FrameOptions {
     pub subsurface: SubsurfaceOptions,
     pub width: u32,
     pub height: u32,
+    /// Time every pass with GPU timestamps.
     pub profile: bool,
+    /// Count nodes visited and points evaluated per pixel on the GPU (costs atomics).
+    pub count_work: bool,
     pub hierarchy: HierarchyOptions,
     pub show: Show,
 }
@@ -75,6 +92,10 @@ pub struct Renderer {
     work_counters: Buffer,
     brute_force: bool,
     shade: ShadePass,
+    /// Shading units per submission, adapted to SUBMISSION_TARGET_S.
+    units_per_submission: usize,
+    /// Advanced by one per shading unit done, when set (the CLI sets one on a terminal).
+    pub progress: Option<indicatif::ProgressBar>,
     debug_view: DebugViewPass,
     show: Show,
     vertices: Buffer,
@@ -91,9 +112,12 @@ pub struct Renderer {
 impl Renderer {
     /// Uploads the scene's mesh and creates the targets for `width` x `height` images.
     pub fn new(ctx: Context, scene: &Scene, options: FrameOptions) -> Result<Renderer> {
-        let FrameOptions { subsurface, width, height, profile, hierarchy, show } = options;
+        let FrameOptions { subsurface, width, height, profile, count_work, hierarchy, show } = options;
         if !(subsurface.epsilon.is_finite() && subsurface.epsilon >= 0.0) {
             return Err(bad_input!("--epsilon {}: must be a finite number ≥ 0", subsurface.epsilon));
+        }
+        if !(subsurface.roughness > 0.0 && subsurface.roughness <= 1.0) {
+            return Err(bad_input!("--roughness {}: must be in (0, 1]", subsurface.roughness));
         }
         let max = ctx.limits().max_image_dimension2_d;
         if width == 0 || height == 0 || width > max || height > max {
@@ -142,7 +166,7 @@ impl Renderer {
         let shade = ShadePass::new(&ctx)?;
         let hierarchy = Hierarchy::new(&ctx, &scene.mesh, &scene.lights, &hierarchy)?;
         let mut params = subsurface_params(&subsurface, scene.mm_per_unit, hierarchy.point_count);
-        params.count_work = (profile && ctx.has_fragment_atomics) as u32;
+        params.count_work = (count_work && ctx.has_fragment_atomics) as u32;
         let work_counters = Buffer::new(
             &ctx,
             "work counters",
@@ -165,6 +189,8 @@ impl Renderer {
             work_counters,
             brute_force: subsurface.brute_force,
             shade,
+            units_per_submission: 1,
+            progress: None,
             debug_view: DebugViewPass::new(&ctx)?,
             show,
             vertices,
@@ -179,39 +205,80 @@ impl Renderer {
         })
     }
 
-    /// Renders one frame and returns its GPU timestamp scopes (empty without a profiler).
+    /// Shading units (tiles, times point ranges for brute force) in one frame.
+    pub fn shading_units(&self) -> usize {
+        self.units().len()
+    }
+
+    fn units(&self) -> Vec<shade::ShadeUnit> {
+        let brute_force_points = self.brute_force.then_some(self.hierarchy.point_count);
+        shade::shade_units(self.extent.width, self.extent.height, TILE, brute_force_points)
+    }
+
+    /// Renders one frame and returns its GPU timestamp scopes (empty without a profiler). The
+    /// lights are taken from `scene` every frame, so they may move between frames.
     pub fn render_frame(&mut self, scene: &Scene) -> Result<Vec<TimedScope>> {
         let aspect = self.extent.width as f32 / self.extent.height as f32;
         let view_projection = scene.camera.view_projection(aspect, self.bounds);
-        let light = scene.lights.first().ok_or_else(|| runtime!("the scene has no light"))?;
-        let constants = ShadeConstants::new(view_projection, scene.camera.eye, light);
+        let constants =
+            ShadeConstants { view_projection, eye: scene.camera.eye.extend(1.0), point_range: glam::UVec4::ZERO };
+        self.hierarchy.set_lights(&scene.mesh, &scene.lights)?;
+        let inputs = ShadeInputs {
+            color: &self.color,
+            depth: &self.depth,
+            vertices: &self.vertices,
+            indices: &self.indices,
+            index_count: self.index_count,
+            params: &self.subsurface_params,
+            nodes: &self.hierarchy.nodes,
+            points: &self.hierarchy.sorted_points,
+            work: &self.work_counters,
+            lights: &self.hierarchy.lights,
+            shadow_map: &self.hierarchy.shadow_map,
+            shadow_sampler: &self.hierarchy.shadow_sampler,
+        };
 
+        // The frame, in order: the hierarchy (sampling, shadow maps, irradiance, Morton codes,
+        // sort, tree build, summaries; each its own scope), the depth pre-pass, shading in
+        // tiles, debug views, then read-back.
         if let Some(p) = self.profiler.as_mut() {
             p.begin_frame();
         }
         self.ctx.submit(self.profiler.as_mut(), |rec| {
-            // The frame, in order: the hierarchy (sampling, shadow maps, irradiance, Morton codes,
-            // sort, tree build, summaries; each its own scope), then shading and read-back.
             self.hierarchy.record(rec, &self.vertices, &self.indices)?;
-
-            rec.begin_scope("shade");
-            self.shade.record(
-                rec,
-                &self.color,
-                &self.depth,
-                &self.vertices,
-                &self.indices,
-                self.index_count,
-                &constants,
-                &self.subsurface_params,
-                &self.hierarchy.nodes,
-                &self.hierarchy.sorted_points,
-                &self.work_counters,
-                self.brute_force.then_some(self.hierarchy.point_count),
-            )?;
+            rec.begin_scope("depth pre-pass");
+            self.shade.record_depth(rec, &inputs, &view_projection)?;
             rec.end_scope();
+            Ok(())
+        })?;
 
-            if self.show == Show::Samples {
+        // Shading in several submissions, so that none runs long (see SUBMISSION_TARGET_S).
+        let units = self.units();
+        let mut done = 0;
+        while done < units.len() {
+            let batch = &units[done..(done + self.units_per_submission).min(units.len())];
+            let started = std::time::Instant::now();
+            self.ctx.submit(self.profiler.as_mut(), |rec| {
+                rec.begin_scope("shade");
+                for unit in batch {
+                    self.shade.record_unit(rec, &inputs, &constants, unit)?;
+                }
+                rec.end_scope();
+                Ok(())
+            })?;
+            let seconds = started.elapsed().as_secs_f64();
+            done += batch.len();
+            if let Some(bar) = &self.progress {
+                bar.inc(batch.len() as u64);
+            }
+            // Grow or shrink the next batch toward the target time, at most ×2 per step.
+            let per_unit = seconds / batch.len() as f64;
+            let fit = (SUBMISSION_TARGET_S / per_unit.max(1e-9)).floor() as usize;
+            self.units_per_submission = fit.clamp(1, 2 * batch.len());
+        }
+
+        if self.show == Show::Samples {
+            self.ctx.submit(self.profiler.as_mut(), |rec| {
                 rec.begin_scope("show samples");
                 let debug = DebugConstants { view_projection, color_scale: Vec3::ONE.extend(2.0) };
                 let n = self.hierarchy.point_count;
@@ -224,9 +291,9 @@ impl Renderer {
                     &debug,
                 )?;
                 rec.end_scope();
-            }
-            Ok(())
-        })?;
+                Ok(())
+            })?;
+        }
         if let Show::Tree(level) = self.show {
             // Debug only: the boxes come from a download of the nodes, drawn in a second submission.
             let nodes = self.hierarchy.download(&self.ctx)?.nodes;

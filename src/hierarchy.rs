@@ -151,10 +151,12 @@ pub struct Hierarchy {
     pub node_parent: Buffer,
     pub point_parent: Buffer,
     pub arrivals: Buffer,
-    lights: Buffer,
-    shadow_map: Image,
-    shadow_sampler: Sampler,
+    pub lights: Buffer,
+    pub shadow_map: Image,
+    pub shadow_sampler: Sampler,
     layer_matrices: Vec<Mat4>,
+    eta: f32,
+    shadow_resolution: u32,
     pub point_count: u32,
     triangle_count: u32,
     index_count: u32,
@@ -223,18 +225,25 @@ impl Hierarchy {
             )?,
             shadow_sampler: Sampler::new(ctx, true, true)?,
             layer_matrices: Vec::new(),
+            eta: options.eta,
+            shadow_resolution: res,
             point_count: n,
             triangle_count: mesh.triangle_count() as u32,
             index_count: mesh.indices.len() as u32,
             bounds: (lo - Vec3::splat(pad), hi + Vec3::splat(pad)),
             seed: 0x9e37_79b9,
         };
-        h.set_lights(mesh, lights, options.eta, res)?;
+        h.set_lights(mesh, lights)?;
         Ok(h)
     }
 
     /// Writes the lights and their shadow matrices (call when lights change, e.g. every frame).
-    pub fn set_lights(&mut self, mesh: &Mesh, lights: &[Light], eta: f32, resolution: u32) -> Result<()> {
+    /// The number of shadow-map layers each light needs must stay what it was at creation.
+    pub fn set_lights(&mut self, mesh: &Mesh, lights: &[Light]) -> Result<()> {
+        let (eta, resolution) = (self.eta, self.shadow_resolution);
+        if lights.is_empty() || lights.len() > MAX_LIGHTS {
+            return Err(bad_input!("between 1 and {MAX_LIGHTS} lights are supported, {} given", lights.len()));
+        }
         let (centre, radius) = crate::scene::bounding_sphere(&mesh.positions);
         let radius = radius.max(1e-6) * 1.01;
         let mut header = LightSetHeader {
@@ -474,10 +483,12 @@ pub fn reference_tree(keys: &[[u32; 2]], points: &[SurfacePoint]) -> Vec<Referen
     nodes
 }
 
-/// Sample count from the material: spacing of half the shortest diffusion length 1/σtr (in scene
-/// units), within [4096, budget]. Returns the count and the spacing it gives.
-pub fn choose_point_count(surface_area: f32, shortest_diffusion_length: f32, budget: u32) -> (u32, f32) {
-    let spacing = 0.5 * shortest_diffusion_length;
+/// Sample count from the material: spacing of half its shortest length scale (the smaller of the
+/// mean free path 1/σ't and the diffusion length 1/σtr), within [4096, budget]. Returns the count
+/// and the spacing it gives. The mean free path matters for the directional dipole, whose
+/// near-field peak is about that wide: points farther apart than it show as speckle.
+pub fn choose_point_count(surface_area: f32, shortest_length: f32, budget: u32) -> (u32, f32) {
+    let spacing = 0.5 * shortest_length;
     let wanted = (surface_area / (spacing * spacing)).ceil();
     let n = if wanted.is_finite() { (wanted as u64).clamp(4096, budget as u64) as u32 } else { budget };
     (n, (surface_area / n as f32).sqrt())

@@ -84,6 +84,20 @@ impl Light {
     }
 }
 
+impl Light {
+    /// The light turned by `angle` radians about the axis `up` through `centre` (directions turn
+    /// about `up`, positions about the axis through `centre`).
+    pub fn rotated(&self, up: Vec3, angle: f32, centre: Vec3) -> Light {
+        let turn = glam::Quat::from_axis_angle(up.normalize_or(Vec3::Y), angle);
+        match *self {
+            Light::Directional { toward, irradiance } => Light::Directional { toward: turn * toward, irradiance },
+            Light::Point { position, intensity } => {
+                Light::Point { position: centre + turn * (position - centre), intensity }
+            }
+        }
+    }
+}
+
 fn check_power(v: Vec3) -> Result<()> {
     if !v.is_finite() || v.min_element() < 0.0 {
         return Err(bad_input!("light intensity {v}: must be finite and non-negative"));

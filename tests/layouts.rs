@@ -10,13 +10,11 @@ fn shade_constants_match_glsl() {
     let glsl = member_offsets("shade.frag", "ShadeConstants").expect("ShadeConstants in shade.frag");
     let rust = vec![
         offset_of!(ShadeConstants, view_projection) as u32,
-        offset_of!(ShadeConstants, light_toward) as u32,
-        offset_of!(ShadeConstants, light_irradiance) as u32,
         offset_of!(ShadeConstants, eye) as u32,
         offset_of!(ShadeConstants, point_range) as u32,
     ];
     assert_eq!(glsl, rust);
-    assert_eq!(size_of::<ShadeConstants>(), 128);
+    assert_eq!(size_of::<ShadeConstants>(), 96);
 }
 
 #[test]
@@ -32,12 +30,15 @@ fn subsurface_params_and_tree_match_glsl() {
         offset_of!(SubsurfaceParams, brute_force),
         offset_of!(SubsurfaceParams, point_count),
         offset_of!(SubsurfaceParams, node_count),
-        offset_of!(SubsurfaceParams, pad),
+        offset_of!(SubsurfaceParams, count_work),
+        offset_of!(SubsurfaceParams, specular),
+        offset_of!(SubsurfaceParams, roughness),
     ]
     .iter()
     .map(|&o| o as u32)
     .collect();
-    assert_eq!(params[..7], rust[..7]);
+    assert_eq!(params[..rust.len()], rust[..]);
+    assert_eq!(size_of::<SubsurfaceParams>(), 240);
     let node = member_offsets("shade.frag", "TreeNode").expect("TreeNode");
     let rust: Vec<u32> = [
         offset_of!(TreeNode, power),

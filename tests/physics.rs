@@ -239,3 +239,44 @@ fn edge_cases_stay_finite() {
     assert!(!absorber.transports);
     assert_eq!(dirpole::sd(&absorber, DVec3::ZERO, n, n, DVec3::X, n), 0.0);
 }
+
+mod microfacet {
+    use glam::DVec3;
+    use translucent::physics::{fresnel, microfacet};
+
+    #[test]
+    fn normal_incidence_equals_the_closed_form() {
+        // h = n: D = 1/(πα²), G2 = 1, so f = F(η, 1)/(4πα²).
+        for (roughness, eta) in [(0.35, 1.3), (0.1, 1.5), (0.8, 1.33)] {
+            let alpha2 = f64::powi(roughness, 4);
+            let expected = fresnel::reflectance(eta, 1.0) / (4.0 * std::f64::consts::PI * alpha2);
+            let got = microfacet::brdf(DVec3::Z, DVec3::Z, DVec3::Z, roughness, eta);
+            assert!((got - expected).abs() <= 1e-12 * expected, "{got} vs {expected}");
+        }
+    }
+
+    #[test]
+    fn is_reciprocal_and_zero_below_the_surface() {
+        let n = DVec3::Z;
+        let a = DVec3::new(0.3, -0.2, 0.9).normalize();
+        let b = DVec3::new(-0.7, 0.1, 0.4).normalize();
+        let (f_ab, f_ba) = (microfacet::brdf(n, a, b, 0.4, 1.4), microfacet::brdf(n, b, a, 0.4, 1.4));
+        assert!((f_ab - f_ba).abs() <= 1e-14 * f_ab);
+        assert_eq!(microfacet::brdf(n, -a, b, 0.4, 1.4), 0.0);
+        assert_eq!(microfacet::brdf(n, a, -b, 0.4, 1.4), 0.0);
+    }
+
+    #[test]
+    fn albedo_is_the_fresnel_reflectance_less_shadowing() {
+        // Seen along the normal, a smooth lobe reflects F(η, 1); rougher ones lose a little to
+        // shadowing-masking (single scattering), never gain.
+        let f0 = fresnel::reflectance(1.5, 1.0);
+        let smooth = microfacet::albedo(DVec3::Z, 0.2, 1.5, 2000);
+        assert!((smooth - f0).abs() <= 0.02 * f0, "{smooth} vs {f0}");
+        let wo = DVec3::new(0.8, 0.0, 0.6);
+        for roughness in [0.3, 0.6, 1.0] {
+            let a = microfacet::albedo(wo, roughness, 1.5, 300);
+            assert!(a > 0.0 && a <= 1.0, "{roughness}: {a}");
+        }
+    }
+}

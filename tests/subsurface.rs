@@ -7,7 +7,8 @@ use common::{output_dir, stderr, translucent};
 /// Renders to EXR (validation on) and returns the linear RGBA pixels.
 fn render(name: &str, args: &[&str]) -> Vec<[f32; 4]> {
     let path = output_dir().join(format!("{name}.exr"));
-    let mut full = vec!["render", "--validation", "--width", "64", "--height", "64", "--samples", "4096"];
+    let mut full =
+        vec!["render", "--validation", "--no-specular", "--width", "64", "--height", "64", "--samples", "4096"];
     full.extend_from_slice(args);
     full.extend_from_slice(&["--out", path.to_str().unwrap()]);
     let out = translucent(&full);
@@ -67,7 +68,8 @@ fn tree_matches_brute_force_within_one_percent() {
 /// A custom material with a short diffusion length (σa = 1, σs' = 2 per mm: 1/σtr = mfp = 1/3 mm),
 /// on a slab 8 × 8 × 2 mm (24 diffusion lengths wide), lit from `light_dir`, seen from straight
 /// above with a narrow field of view; returns the centre pixel's radiance (red channel).
-/// `extra` picks the integration: `--brute-force` checks the model, sampling and irradiance alone;
+/// `extra` picks the integration: `--brute-force` checks the model, sampling and irradiance alone
+/// (`--no-specular` is added unless `extra` has `--roughness`);
 /// the tree's own error (a node at its power centre underestimates a convex Sd) is measured
 /// against brute force in `tree_matches_brute_force_within_one_percent` and printed here.
 fn slab_centre(model: &str, light_dir: &str, extra: &[&str]) -> f32 {
@@ -106,6 +108,9 @@ fn slab_centre(model: &str, light_dir: &str, extra: &[&str]) -> f32 {
     let mut full = vec!["render", "--validation", "--width", "8", "--height", "8"];
     full.extend_from_slice(&args);
     full.extend_from_slice(extra);
+    if !extra.contains(&"--roughness") {
+        full.push("--no-specular");
+    }
     full.extend_from_slice(&["--out", path.to_str().unwrap()]);
     let out = translucent(&full);
     assert!(out.status.success(), "{}", stderr(&out));
@@ -174,14 +179,40 @@ fn thick_slab_directional_dipole_equals_the_plane_integral() {
     }
 }
 
+/// The microfacet lobe seen and lit along the normal: f cos θi E = F(η, 1) E / (4π α²), α = r²
+/// (D = 1/(πα²), G2 = 1 at normal incidence), added to the subsurface term.
+#[test]
+fn specular_lobe_at_normal_incidence_equals_the_closed_form() {
+    use translucent::physics::fresnel;
+    let roughness = 0.35f64;
+    let alpha2 = roughness.powi(4);
+    let expected = fresnel::reflectance(1.3, 1.0) / (4.0 * std::f64::consts::PI * alpha2);
+    let without = slab_centre("dipole", "0,1,0", &[]) as f64;
+    let with = slab_centre("dipole", "0,1,0", &["--roughness", "0.35"]) as f64;
+    let lobe = with - without;
+    println!("specular at normal incidence: {lobe:.6} vs F/(4πα²) = {expected:.6}");
+    assert!((lobe - expected).abs() <= 0.01 * expected, "{lobe} vs {expected}");
+}
+
 /// `--profile` reports the work per pixel counted on the GPU: brute force evaluates every point at
 /// every pixel, the tree far fewer.
 #[test]
 fn profile_counts_work_per_pixel() {
     let run = |extra: &[&str]| {
         let path = output_dir().join("work.png");
-        let mut args =
-            vec!["render", "--validation", "--width", "16", "--height", "16", "--samples", "10000", "--profile"];
+        let mut args = vec![
+            "render",
+            "--validation",
+            "--mesh",
+            "sphere",
+            "--width",
+            "16",
+            "--height",
+            "16",
+            "--samples",
+            "10000",
+            "--profile",
+        ];
         args.extend_from_slice(extra);
         args.extend_from_slice(&["--out", path.to_str().unwrap()]);
         let out = translucent(&args);

@@ -10,14 +10,6 @@ layout(std430, binding = 1) readonly buffer Lights { LightSet light_set; mat4 la
 layout(binding = 2) uniform sampler2DArrayShadow shadow_map;
 layout(push_constant) uniform IrradianceConstants { uint point_count; } pc;
 
-// Cube face of a direction from a point light: +x, -x, +y, -y, +z, -z (as in src/passes/shadow.rs).
-uint cube_face(vec3 d) {
-    vec3 a = abs(d);
-    if (a.x >= a.y && a.x >= a.z) return d.x >= 0.0 ? 0u : 1u;
-    if (a.y >= a.z) return d.y >= 0.0 ? 2u : 3u;
-    return d.z >= 0.0 ? 4u : 5u;
-}
-
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= pc.point_count) return;
@@ -27,18 +19,8 @@ void main() {
     for (uint k = 0u; k < light_set.light_count; ++k) {
         GpuLight light = light_set.lights[k];
         vec3 toward;
-        vec3 incident;
-        uint layer = light.first_layer;
-        if (light.position.w == 0.0) {
-            toward = normalize(light.position.xyz);
-            incident = light.intensity.rgb;
-        } else {
-            vec3 d = light.position.xyz - p.position;
-            float d2 = max(dot(d, d), 1e-20);
-            toward = d * inversesqrt(d2);
-            incident = light.intensity.rgb / d2;
-            layer += cube_face(-d);
-        }
+        uint layer;
+        vec3 incident = light_at(light, p.position, toward, layer);
         float cos_theta = dot(p.normal, toward);
         if (cos_theta <= 0.0) continue;
         // Offset along the normal by a few shadow-map texels so lit surfaces do not shadow themselves.

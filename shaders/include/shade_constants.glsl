@@ -4,8 +4,6 @@
 #define SHADE_CONSTANTS_GLSL
 layout(push_constant, std430) uniform ShadeConstants {
     mat4 view_projection;
-    vec4 light_toward;     // xyz: unit direction toward the light (directional) or position (point); w: 0 directional, 1 point
-    vec4 light_irradiance; // rgb: irradiance at normal incidence (directional) or intensity (point)
     vec4 eye;              // xyz: camera position
     uvec4 point_range;     // brute force: first point and count of this draw (draws add up)
 } pc;

@@ -11,6 +11,10 @@ struct SubsurfaceParams {
     uint point_count;
     uint node_count;
     uint count_work;           // 1: add this pixel's work to the counters (--profile)
+    uint specular;             // 1: add the microfacet lobe (--no-specular: 0)
+    float roughness;           // of the microfacet lobe; alpha = roughness²
+    uint pad0;
     uint pad1;
+    uint pad2;
 };
 #endif

@@ -1,15 +1,15 @@
 //! The shade pass: rasterises the mesh and, per fragment, integrates the BSSRDF over the tree
-//! (shaders/shade.frag). Reads: vertices, indices, parameters, tree nodes, sorted points.
-//! Writes: colour and depth targets.
+//! (shaders/shade.frag), plus the surface's microfacet reflection. Reads: vertices, indices,
+//! parameters, tree nodes, sorted points, lights and shadow maps. Writes: colour and depth
+//! targets, work counters.
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec4};
 
 use crate::error::Result;
-use crate::scene::Light;
 use crate::vk::{
     self, Bind, BindingKind, Buffer, Context, CullModeFlags, Format, GraphicsDesc, Image, Pipeline, PrimitiveTopology,
-    Recorder,
+    Recorder, Sampler,
 };
 
 pub const COLOR_FORMAT: Format = Format::R32G32B32A32_SFLOAT;
@@ -20,8 +20,6 @@ pub const DEPTH_FORMAT: Format = Format::D32_SFLOAT;
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct ShadeConstants {
     pub view_projection: Mat4,
-    pub light_toward: Vec4,
-    pub light_irradiance: Vec4,
     pub eye: Vec4,
     /// Brute force: first point and count of one draw; draws are added by blending.
     pub point_range: glam::UVec4,
@@ -44,7 +42,10 @@ pub struct SubsurfaceParams {
     pub node_count: u32,
     /// 1 to count the work per pixel (nodes visited, points evaluated) for `--profile`.
     pub count_work: u32,
-    pub pad: u32,
+    /// 1 to add the microfacet lobe.
+    pub specular: u32,
+    pub roughness: f32,
+    pub pad: [u32; 3],
 }
 
 /// Mirrors `WorkCounters` in shaders/shade.frag.
@@ -58,20 +59,50 @@ pub struct WorkCounters {
     pub point_max: u32,
 }
 
-impl ShadeConstants {
-    pub fn new(view_projection: Mat4, eye: glam::Vec3, light: &Light) -> ShadeConstants {
-        let (toward, irradiance) = match *light {
-            Light::Directional { toward, irradiance } => (toward.normalize().extend(0.0), irradiance.extend(0.0)),
-            Light::Point { position, intensity } => (position.extend(1.0), intensity.extend(0.0)),
-        };
-        ShadeConstants {
-            view_projection,
-            light_toward: toward,
-            light_irradiance: irradiance,
-            eye: eye.extend(1.0),
-            point_range: glam::UVec4::ZERO,
+/// Everything a shading draw reads, and the targets it writes.
+pub struct ShadeInputs<'a> {
+    pub color: &'a Image,
+    pub depth: &'a Image,
+    pub vertices: &'a Buffer,
+    pub indices: &'a Buffer,
+    pub index_count: u32,
+    pub params: &'a Buffer,
+    pub nodes: &'a Buffer,
+    pub points: &'a Buffer,
+    pub work: &'a Buffer,
+    pub lights: &'a Buffer,
+    pub shadow_map: &'a Image,
+    pub shadow_sampler: &'a Sampler,
+}
+
+/// One piece of a frame's shading: a rectangle of pixels and, for brute force, a range of points.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ShadeUnit {
+    pub x: u32,
+    pub y: u32,
+    pub width: u32,
+    pub height: u32,
+    pub first_point: u32,
+    pub point_count: u32,
+}
+
+/// Tiles of `tile` pixels over `width` x `height`, each repeated for every range of
+/// `POINTS_PER_DRAW` points when brute force sums `brute_force_points` points.
+pub fn shade_units(width: u32, height: u32, tile: u32, brute_force_points: Option<u32>) -> Vec<ShadeUnit> {
+    let ranges: Vec<(u32, u32)> = match brute_force_points {
+        None => vec![(0, 0)],
+        Some(n) => (0..n.max(1)).step_by(POINTS_PER_DRAW as usize).map(|f| (f, POINTS_PER_DRAW)).collect(),
+    };
+    let mut units = Vec::new();
+    for y in (0..height).step_by(tile as usize) {
+        for x in (0..width).step_by(tile as usize) {
+            for &(first_point, point_count) in &ranges {
+                let (w, h) = (tile.min(width - x), tile.min(height - y));
+                units.push(ShadeUnit { x, y, width: w, height: h, first_point, point_count });
+            }
         }
     }
+    units
 }
 
 pub struct ShadePass {
@@ -87,6 +118,7 @@ const VERTEX_STRIDE: u32 = 24;
 
 impl ShadePass {
     pub fn new(ctx: &Context) -> Result<ShadePass> {
+        use BindingKind::*;
         let shading = |additive_blend: bool| {
             Pipeline::graphics(
                 ctx,
@@ -103,7 +135,14 @@ impl ShadePass {
                     depth_bias: false,
                     cull_mode: CullModeFlags::NONE,
                     additive_blend,
-                    bindings: &[BindingKind::StorageBuffer; 4],
+                    bindings: &[
+                        StorageBuffer,
+                        StorageBuffer,
+                        StorageBuffer,
+                        StorageBuffer,
+                        StorageBuffer,
+                        SampledImage,
+                    ],
                     push_constant_size: std::mem::size_of::<ShadeConstants>() as u32,
                 },
             )
@@ -132,52 +171,47 @@ impl ShadePass {
         Ok(ShadePass { depth_prepass, pipeline, additive })
     }
 
-    #[allow(clippy::too_many_arguments)]
-    pub fn record(
+    /// Clears the colour target and the work counters and lays down depth, so that the shading
+    /// draws run their fragment shader once per pixel.
+    pub fn record_depth(&self, rec: &mut Recorder, inputs: &ShadeInputs, view_projection: &Mat4) -> Result<()> {
+        rec.fill_buffer(inputs.work, 0)?;
+        rec.begin_rendering(&[(inputs.color, Some([0.0; 4]))], None, 0)?;
+        rec.end_rendering();
+        rec.begin_rendering(&[], Some((inputs.depth, Some(1.0))), 0)?;
+        let (v, i) = (Some(inputs.vertices), Some(inputs.indices));
+        rec.draw(&self.depth_prepass, &[], vk::bytes_of(view_projection), v, i, inputs.index_count, 1)?;
+        rec.end_rendering();
+        Ok(())
+    }
+
+    /// Shades one unit: its rectangle, over its range of points for brute force (added by
+    /// blending to what earlier ranges left), else by walking the tree.
+    pub fn record_unit(
         &self,
         rec: &mut Recorder,
-        color: &Image,
-        depth: &Image,
-        vertices: &Buffer,
-        indices: &Buffer,
-        index_count: u32,
+        inputs: &ShadeInputs,
         constants: &ShadeConstants,
-        params: &Buffer,
-        nodes: &Buffer,
-        points: &Buffer,
-        work: &Buffer,
-        brute_force_points: Option<u32>,
+        unit: &ShadeUnit,
     ) -> Result<()> {
-        rec.fill_buffer(work, 0)?;
-        let binds = [Bind::Read(params), Bind::Read(nodes), Bind::Read(points), Bind::Write(work)];
-        rec.use_buffer(vertices, vk::Access::VERTEX_INPUT)?;
-        rec.use_buffer(indices, vk::Access::INDEX_INPUT)?;
+        let binds = [
+            Bind::Read(inputs.params),
+            Bind::Read(inputs.nodes),
+            Bind::Read(inputs.points),
+            Bind::Write(inputs.work),
+            Bind::Read(inputs.lights),
+            Bind::Sampled(inputs.shadow_map, inputs.shadow_sampler),
+        ];
+        let mut c = *constants;
+        c.point_range = glam::UVec4::new(unit.first_point, unit.point_count, 0, 0);
+        let pipeline = if unit.point_count > 0 { &self.additive } else { &self.pipeline };
+        // One rendering scope per unit: every draw writes the work counters, and the barrier
+        // between two writes cannot sit inside a rendering scope.
         rec.prepare_draw_reads(&binds)?;
-        rec.begin_rendering(&[], Some((depth, Some(1.0))), 0)?;
-        let matrix = constants.view_projection;
-        rec.draw(&self.depth_prepass, &[], vk::bytes_of(&matrix), Some(vertices), Some(indices), index_count, 1)?;
+        rec.begin_rendering(&[(inputs.color, None)], Some((inputs.depth, None)), 0)?;
+        rec.set_scissor(unit.x, unit.y, unit.width, unit.height);
+        let (v, i) = (Some(inputs.vertices), Some(inputs.indices));
+        rec.draw(pipeline, &binds, vk::bytes_of(&c), v, i, inputs.index_count, 1)?;
         rec.end_rendering();
-        match brute_force_points {
-            None => {
-                rec.begin_rendering(&[(color, Some([0.0; 4]))], Some((depth, None)), 0)?;
-                let c = vk::bytes_of(constants);
-                rec.draw(&self.pipeline, &binds, c, Some(vertices), Some(indices), index_count, 1)?;
-                rec.end_rendering();
-            }
-            Some(total) => {
-                // One rendering scope per draw: every draw writes the work counters, and the
-                // barrier between two writes cannot sit inside a rendering scope.
-                for first in (0..total.max(1)).step_by(POINTS_PER_DRAW as usize) {
-                    let clear = (first == 0).then_some([0.0; 4]);
-                    let mut c = *constants;
-                    c.point_range = glam::UVec4::new(first, POINTS_PER_DRAW, 0, 0);
-                    rec.prepare_draw_reads(&binds)?;
-                    rec.begin_rendering(&[(color, clear)], Some((depth, None)), 0)?;
-                    rec.draw(&self.additive, &binds, vk::bytes_of(&c), Some(vertices), Some(indices), index_count, 1)?;
-                    rec.end_rendering();
-                }
-            }
-        }
         Ok(())
     }
 }

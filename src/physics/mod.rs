@@ -7,6 +7,7 @@
 pub mod dipole;
 pub mod dirpole;
 pub mod fresnel;
+pub mod microfacet;
 
 use bytemuck::{Pod, Zeroable};
 
