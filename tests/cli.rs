@@ -10,11 +10,14 @@ fn assert_bad_input(args: &[&str], needle: &str) {
     let out = common::output_dir().join("bad-input.png");
     // Validation on: several of these cases create a device before they are refused.
     let mut full = vec!["render", "--validation", "--out", out.to_str().unwrap()];
-    // Small images unless the case is about the size itself.
+    // Small images of the sphere unless the case is about the size or the mesh itself.
     for flag in ["--width", "--height"] {
         if !args.contains(&flag) {
             full.extend_from_slice(&[flag, "16"]);
         }
+    }
+    if !args.contains(&"--mesh") {
+        full.extend_from_slice(&["--mesh", "sphere"]);
     }
     full.extend_from_slice(args);
     let result = translucent(&full);
@@ -62,6 +65,12 @@ fn bad_flag_values() {
     assert_bad_input(&["--frames", "0"], "--frames");
     assert_bad_input(&["--device", "no-such-device"], "no-such-device");
     assert_bad_input(&["--no-such-flag"], "--no-such-flag");
+    assert_bad_input(&["--roughness", "0"], "--roughness");
+    assert_bad_input(&["--roughness", "-0.5"], "--roughness");
+    assert_bad_input(&["--roughness", "1.5"], "--roughness");
+    assert_bad_input(&["--roughness", "nan"], "--roughness");
+    assert_bad_input(&["--spin-light", "inf"], "--spin-light");
+    assert_bad_input(&["--epsilon", "-1"], "--epsilon");
 }
 
 #[test]

@@ -104,3 +104,54 @@ fn profile_json_has_every_pass() {
         assert!(timed.iter().all(|e| e["dur"].as_f64().unwrap() > 0.0), "{pass}: positive durations");
     }
 }
+
+/// `--frames N --spin-light DEG` with `{frame}` in `--out` writes every frame; the light turns
+/// about the vertical axis and the hierarchy is rebuilt, so frames differ, and a whole turn comes
+/// back to the first frame.
+#[test]
+fn spinning_light_writes_every_frame() {
+    let dir = output_dir().join("spin");
+    std::fs::create_dir_all(&dir).unwrap();
+    for f in std::fs::read_dir(&dir).unwrap() {
+        std::fs::remove_file(f.unwrap().path()).unwrap();
+    }
+    let pattern = dir.join("frame-{frame}.exr");
+    let out = translucent(&[
+        "render",
+        "--validation",
+        "--mesh",
+        "torus",
+        "--width",
+        "32",
+        "--height",
+        "32",
+        "--samples",
+        "4096",
+        "--light",
+        "dir:1,0.5,0",
+        "--frames",
+        "5",
+        "--spin-light",
+        "90",
+        "--out",
+        pattern.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let frames: Vec<Vec<f32>> = (0..5)
+        .map(|k| {
+            let path = dir.join(format!("frame-{k:04}.exr"));
+            image::open(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display())).into_rgba32f().into_raw()
+        })
+        .collect();
+    let relative_difference = |a: &[f32], b: &[f32]| {
+        let num: f64 = a.iter().zip(b).map(|(x, y)| (*x as f64 - *y as f64).powi(2)).sum();
+        let den: f64 = b.iter().map(|y| (*y as f64).powi(2)).sum();
+        (num / den).sqrt()
+    };
+    let quarter = relative_difference(&frames[1], &frames[0]);
+    let turn = relative_difference(&frames[4], &frames[0]);
+    println!("spinning light: a quarter turn changes the image by {quarter:.3}, a whole turn by {turn:.2e}");
+    assert!(quarter > 0.05, "the light did not move: {quarter}");
+    assert!(turn < 1e-3, "a whole turn must come back to the first frame: {turn}");
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 5, "one file per frame");
+}

@@ -215,3 +215,35 @@ impl ShadePass {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every pixel is in exactly one tile, once per range of points, and the ranges cover every
+    /// point.
+    #[test]
+    fn units_cover_every_pixel_and_point_once() {
+        for (w, h, tile, points) in
+            [(96, 96, 128, None), (300, 130, 128, None), (257, 1, 64, Some(20_000)), (1, 1, 128, Some(2))]
+        {
+            let units = shade_units(w, h, tile, points);
+            let mut cover = vec![0u32; (w * h) as usize];
+            for u in &units {
+                assert!(u.width <= tile && u.height <= tile && u.width > 0 && u.height > 0);
+                for y in u.y..u.y + u.height {
+                    for x in u.x..u.x + u.width {
+                        cover[(y * w + x) as usize] += 1;
+                    }
+                }
+            }
+            let ranges = points.map(|n: u32| n.div_ceil(POINTS_PER_DRAW)).unwrap_or(1);
+            assert!(cover.iter().all(|&c| c == ranges), "{w}x{h} tile {tile}: {cover:?}");
+            if let Some(n) = points {
+                let mut seen: Vec<u32> = units.iter().filter(|u| u.x == 0 && u.y == 0).map(|u| u.first_point).collect();
+                seen.sort();
+                assert_eq!(seen, (0..n).step_by(POINTS_PER_DRAW as usize).collect::<Vec<_>>());
+            }
+        }
+    }
+}
