@@ -27,23 +27,86 @@ pub fn luminance(p: [f32; 4]) -> f32 {
     0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]
 }
 
-/// The scale that maps the 95th-percentile luminance of the covered pixels to 1.0 before the tone
-/// curve (≈ 0.8 after it): highlights keep some room and a few hot pixels cannot darken the image.
-/// An all-black image gets scale 1.
-pub fn auto_exposure_scale(img: &HdrImage) -> f32 {
-    let mut lum: Vec<f32> =
-        img.pixels.iter().filter(|p| p[3] > 0.0).map(|&p| luminance(p)).filter(|l| l.is_finite() && *l > 0.0).collect();
-    if lum.is_empty() {
-        return 1.0;
-    }
-    let k = ((lum.len() - 1) as f32 * 0.95) as usize;
-    let (_, p95, _) = lum.select_nth_unstable_by(k, f32::total_cmp);
-    1.0 / *p95
+/// Auto-exposure histogram of log2 luminance: `HIST_BINS_PER_STOP` bins per stop from
+/// 2^`HIST_LOG2_MIN` up (1/16 stop over [−40, +24) stops); the ends collect what lies outside.
+/// shaders/tonemap.comp gets these through `HistogramTables` (passes/tonemap.rs), never its own copy.
+pub const HIST_LOG2_MIN: i32 = -40;
+pub const HIST_BINS_PER_STOP: usize = 16;
+pub const HIST_BINS: usize = 1024;
+
+/// Lower bin edges within one stop, 2^(j/16) rounded to f32. A luminance is binned by its exponent
+/// bits and by comparing its mantissa with these, so CPU and GPU bin identically (a log2 in f32
+/// differs in the last bit between libraries and would move pixels across bin edges).
+pub fn stop_thresholds() -> [f32; HIST_BINS_PER_STOP] {
+    std::array::from_fn(|j| (j as f64 / HIST_BINS_PER_STOP as f64).exp2() as f32)
 }
 
-/// ACES filmic curve, Narkowicz's 2015 fit: maps [0, ∞) to [0, 1), monotonic, f(0) = 0.
+/// 1 / (geometric centre) of each bin within one stop, 2^(−(j+½)/16) rounded to f32: the exposure
+/// scale of a bin is this times an exact power of two, again identical on CPU and GPU.
+pub fn bin_inverse_centres() -> [f32; HIST_BINS_PER_STOP] {
+    std::array::from_fn(|j| (-(j as f64 + 0.5) / HIST_BINS_PER_STOP as f64).exp2() as f32)
+}
+
+/// The histogram bin of a covered pixel's luminance, or `None` when it does not count: not finite,
+/// ≤ 0, or subnormal (a GPU may flush those to zero).
+pub fn luminance_bin(l: f32, thresholds: &[f32; HIST_BINS_PER_STOP]) -> Option<usize> {
+    let bits = l.to_bits();
+    if !(0x0080_0000..0x7f80_0000).contains(&bits) {
+        return None;
+    }
+    let stop = (bits >> 23) as i32 - 127 - HIST_LOG2_MIN;
+    if stop < 0 {
+        return Some(0);
+    }
+    let mantissa = f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000); // in [1, 2)
+    let within = thresholds[1..].iter().filter(|&&t| mantissa >= t).count();
+    Some((stop as usize * HIST_BINS_PER_STOP + within).min(HIST_BINS - 1))
+}
+
+/// The exposure scale of bin `bin`: 1 / its geometric centre 2^(HIST_LOG2_MIN + (bin + ½)/16).
+pub fn bin_exposure_scale(bin: usize, inverse_centres: &[f32; HIST_BINS_PER_STOP]) -> f32 {
+    let stop = HIST_LOG2_MIN + (bin / HIST_BINS_PER_STOP) as i32;
+    inverse_centres[bin % HIST_BINS_PER_STOP] * f32::from_bits(((127 - stop) as u32) << 23)
+}
+
+/// The auto-exposure histogram: how many covered pixels (alpha > 0) fall in each luminance bin.
+pub fn luminance_histogram(img: &HdrImage) -> Vec<u32> {
+    let thresholds = stop_thresholds();
+    let mut bins = vec![0u32; HIST_BINS];
+    for p in img.pixels.iter().filter(|p| p[3] > 0.0) {
+        if let Some(b) = luminance_bin(luminance(*p), &thresholds) {
+            bins[b] += 1;
+        }
+    }
+    bins
+}
+
+/// The scale that maps the 95th-percentile luminance of the covered pixels (alpha > 0) to 1.0 before
+/// the tone curve (≈ 0.8 after it): highlights keep some room and a few hot pixels cannot darken the
+/// image. The percentile is the centre of the histogram bin holding rank ⌊(n−1)·0.95⌋ (0-based), the
+/// same walk the GPU does. An image with nothing covered, or only black, gets scale 1.
+pub fn auto_exposure_scale(img: &HdrImage) -> f32 {
+    let bins = luminance_histogram(img);
+    let count: u32 = bins.iter().sum();
+    if count == 0 {
+        return 1.0;
+    }
+    let rank = ((count - 1) as f32 * 0.95) as u32;
+    let mut seen = 0;
+    let bin = bins.iter().position(|&n| {
+        seen += n;
+        seen > rank
+    });
+    bin_exposure_scale(bin.unwrap_or(HIST_BINS - 1), &bin_inverse_centres())
+}
+
+/// filmic(x) is 1 from x ≈ 7.25 on; inputs are capped here so that +∞ and huge values stay white
+/// instead of overflowing to ∞/∞ = NaN.
+const FILMIC_INPUT_MAX: f32 = 64.0;
+
+/// ACES filmic curve, Narkowicz's 2015 fit: maps [0, ∞] to [0, 1], monotonic, f(0) = 0, NaN → 0.
 pub fn filmic(x: f32) -> f32 {
-    let x = x.max(0.0);
+    let x = if x.is_nan() { 0.0 } else { x.clamp(0.0, FILMIC_INPUT_MAX) };
     ((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14)).clamp(0.0, 1.0)
 }
 
@@ -57,12 +120,18 @@ pub fn srgb_encode(linear: f32) -> f32 {
     }
 }
 
-/// Exposure → filmic curve → sRGB → 8 bits; alpha from coverage. NaN becomes black.
-pub fn tonemap(img: &HdrImage, exposure: Exposure) -> image::RgbaImage {
-    let scale = match exposure {
+/// The multiplier applied to radiance before the tone curve.
+pub fn exposure_scale(img: &HdrImage, exposure: Exposure) -> f32 {
+    match exposure {
         Exposure::Auto => auto_exposure_scale(img),
         Exposure::Stops(s) => 2f32.powf(s),
-    };
+    }
+}
+
+/// Exposure → filmic curve → sRGB → 8 bits (+0.5 rounding); alpha from coverage. NaN becomes 0, +∞
+/// white. shaders/tonemap.comp (stage 2) is the GPU twin.
+pub fn tonemap(img: &HdrImage, exposure: Exposure) -> image::RgbaImage {
+    let scale = exposure_scale(img, exposure);
     let to8 = |v: f32| (srgb_encode(filmic(if v.is_nan() { 0.0 } else { v * scale })) * 255.0 + 0.5) as u8;
     let mut out = image::RgbaImage::new(img.width, img.height);
     for (dst, src) in out.pixels_mut().zip(&img.pixels) {
@@ -70,6 +139,15 @@ pub fn tonemap(img: &HdrImage, exposure: Exposure) -> image::RgbaImage {
         *dst = image::Rgba([to8(src[0]), to8(src[1]), to8(src[2]), alpha]);
     }
     out
+}
+
+/// The GPU tone-mapping output (one u32 per pixel, R in the low byte, rows top to bottom) as an
+/// image.
+pub fn rgba8_from_packed(width: u32, height: u32, packed: &[u32]) -> Result<image::RgbaImage> {
+    let bytes: Vec<u8> = packed.iter().flat_map(|p| p.to_le_bytes()).collect();
+    let n = packed.len();
+    image::RgbaImage::from_raw(width, height, bytes)
+        .ok_or_else(|| runtime!("{n} packed pixels do not make a {width}x{height} image"))
 }
 
 /// Writes `.exr` (linear float RGBA, untouched) or `.png` (tone-mapped sRGB), by extension.
@@ -158,6 +236,52 @@ mod tests {
         let nan = HdrImage { width: 2, height: 1, pixels: vec![[f32::NAN, 0.0, 0.0, 1.0], [1.0, 1.0, 1.0, 1.0]] };
         let png = tonemap(&nan, Exposure::Auto);
         assert_eq!(png.get_pixel(0, 0)[0], 0);
+    }
+
+    #[test]
+    fn histogram_bins_follow_log2_luminance() {
+        let t = stop_thresholds();
+        assert_eq!(luminance_bin(1.0, &t), Some(640));
+        assert_eq!(luminance_bin(2f32.powf(1.0 / 16.0) * 1.0001, &t), Some(641));
+        assert_eq!(luminance_bin(0.999, &t), Some(639));
+        assert_eq!(luminance_bin(1e-30, &t), Some(0));
+        assert_eq!(luminance_bin(1e30, &t), Some(HIST_BINS - 1));
+        for bad in [0.0, -1.0, f32::NAN, f32::INFINITY, 1e-40] {
+            assert_eq!(luminance_bin(bad, &t), None);
+        }
+        // Agrees with log2 away from the edges, over 1e-11 … 1e7 (inside [2^-40, 2^24)).
+        for i in 0..1800 {
+            let l = 10f32.powf(-11.0 + i as f32 * 0.01);
+            let exact = ((l as f64).log2() - HIST_LOG2_MIN as f64) * HIST_BINS_PER_STOP as f64;
+            if (exact - exact.round()).abs() > 1e-3 {
+                assert_eq!(luminance_bin(l, &t), Some(exact.floor() as usize), "{l}");
+            }
+        }
+        let scale = bin_exposure_scale(640, &bin_inverse_centres());
+        assert!((scale as f64 - (-1.0f64 / 32.0).exp2()).abs() < 1e-7);
+    }
+
+    #[test]
+    fn auto_exposure_takes_the_95th_percentile_bin() {
+        // 100 pixels at 1.0 and 5 far brighter: rank ⌊104·0.95⌋ = 98 is still at 1.0.
+        let mut pixels = vec![[1.0, 1.0, 1.0, 1.0]; 100];
+        pixels.extend([[1e3, 1e3, 1e3, 1.0]; 5]);
+        pixels.push([1e6, 1e6, 1e6, 0.0]); // background does not count
+        let img = HdrImage { width: 106, height: 1, pixels };
+        let lum = luminance([1.0; 4]);
+        let expected = bin_exposure_scale(luminance_bin(lum, &stop_thresholds()).unwrap(), &bin_inverse_centres());
+        assert_eq!(auto_exposure_scale(&img), expected);
+        assert!((expected * lum - 1.0).abs() < 0.025, "within half a bin (1/32 stop) of 1/L95");
+    }
+
+    #[test]
+    fn infinity_is_white_and_packing_is_rgba() {
+        let img = HdrImage { width: 1, height: 1, pixels: vec![[f32::INFINITY, f32::NEG_INFINITY, 1e30, 0.5]] };
+        let png = tonemap(&img, Exposure::Stops(0.0));
+        assert_eq!(png.get_pixel(0, 0).0, [255, 0, 255, 128]);
+        let packed = rgba8_from_packed(1, 1, &[0x8040_2010]).unwrap();
+        assert_eq!(packed.get_pixel(0, 0).0, [0x10, 0x20, 0x40, 0x80]);
+        assert!(rgba8_from_packed(2, 1, &[0]).is_err());
     }
 
     #[test]

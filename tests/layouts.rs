@@ -93,3 +93,34 @@ fn bssrdf_structs_match_glsl() {
     ];
     assert_eq!(query, rust);
 }
+
+#[test]
+fn tonemap_structs_match_glsl() {
+    use translucent::passes::tonemap::{HistogramTables, TonemapConstants, HISTOGRAM_HEADER_BYTES};
+    let tables = member_offsets("tonemap.comp", "HistogramTables").expect("HistogramTables");
+    let rust: Vec<u32> = [
+        offset_of!(HistogramTables, thresholds),
+        offset_of!(HistogramTables, inv_centres),
+        offset_of!(HistogramTables, log2_min),
+        offset_of!(HistogramTables, bin_count),
+    ]
+    .iter()
+    .map(|&o| o as u32)
+    .collect();
+    // The offsets also pin the GLSL array lengths to HIST_BINS_PER_STOP.
+    assert_eq!(tables, rust);
+    let constants = member_offsets("tonemap.comp", "TonemapConstants").expect("TonemapConstants");
+    let rust: Vec<u32> = [
+        offset_of!(TonemapConstants, stage),
+        offset_of!(TonemapConstants, width),
+        offset_of!(TonemapConstants, height),
+        offset_of!(TonemapConstants, fixed_exposure),
+        offset_of!(TonemapConstants, fixed_scale),
+    ]
+    .iter()
+    .map(|&o| o as u32)
+    .collect();
+    assert_eq!(constants, rust);
+    let histogram = member_offsets("tonemap.comp", "Histogram").expect("Histogram");
+    assert_eq!(histogram.last().copied(), Some(HISTOGRAM_HEADER_BYTES as u32), "bins follow the header");
+}

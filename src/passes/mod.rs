@@ -7,4 +7,5 @@ pub mod sampling;
 pub mod shade;
 pub mod shadow;
 pub mod sort;
+pub mod tonemap;
 pub mod tree;

@@ -573,6 +573,47 @@ impl<'a> Recorder<'a> {
         self.use_buffer(dst, Access::HOST_READ)
     }
 
+    /// Fills layer 0 of a colour image from a tightly packed buffer (uploads, tests); the image's
+    /// earlier contents are discarded.
+    pub fn copy_buffer_to_image(&mut self, src: &Buffer, dst: &Image) -> Result<()> {
+        let texel = match dst.format {
+            vk::Format::R32G32B32A32_SFLOAT => 16,
+            vk::Format::R8G8B8A8_UNORM | vk::Format::R8G8B8A8_SRGB | vk::Format::R32_SFLOAT => 4,
+            f => return Err(runtime!("copy_buffer_to_image into {}: format {f:?} not supported", dst.name)),
+        };
+        let bytes = texel * dst.extent.width as u64 * dst.extent.height as u64;
+        if src.size < bytes {
+            return Err(runtime!("copy of {} ({} bytes) into {} needs {bytes} bytes", src.name, src.size, dst.name));
+        }
+        self.use_buffer(src, Access { layout: vk::ImageLayout::UNDEFINED, ..Access::TRANSFER_READ })?;
+        self.discard_image(dst);
+        self.use_image(dst, Access::TRANSFER_WRITE)?;
+        let region = [vk::BufferImageCopy {
+            buffer_offset: 0,
+            buffer_row_length: 0,
+            buffer_image_height: 0,
+            image_subresource: vk::ImageSubresourceLayers {
+                aspect_mask: aspect_of(dst.format),
+                mip_level: 0,
+                base_array_layer: 0,
+                layer_count: 1,
+            },
+            image_offset: vk::Offset3D::default(),
+            image_extent: vk::Extent3D { width: dst.extent.width, height: dst.extent.height, depth: 1 },
+        }];
+        // SAFETY: the image is in TRANSFER_DST_OPTIMAL (barrier above); the buffer holds the region.
+        unsafe {
+            self.device().cmd_copy_buffer_to_image(
+                self.cmd,
+                src.raw,
+                dst.raw,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                &region,
+            )
+        };
+        Ok(())
+    }
+
     /// Makes a buffer written on the GPU readable by the host after the submission's fence.
     pub fn host_read(&mut self, buffer: &Buffer) -> Result<()> {
         self.use_buffer(buffer, Access::HOST_READ)
