@@ -52,6 +52,7 @@ pub fn run(options: &BenchOptions) -> Result<String> {
                 count_work: false,
                 hierarchy: HierarchyOptions { point_count: n, shadow_resolution: 1024, eta: 1.3 },
                 show: Show::Shading,
+                exposure: crate::output::Exposure::Auto,
             };
             let mut renderer = Renderer::new(ctx, &scene, frame_options)?;
             let mut frames = Vec::new();

@@ -10,7 +10,7 @@ use crate::frame::{FrameOptions, Renderer, Show, SubsurfaceOptions};
 use crate::hierarchy::HierarchyOptions;
 use crate::materials::Material;
 use crate::mesh::Mesh;
-use crate::output::{self, Exposure};
+use crate::output::Exposure;
 use crate::physics::{Diffusion, Model};
 use crate::scene::{Camera, Light, Scene};
 use crate::vk::{self, Context, ContextOptions};
@@ -571,6 +571,7 @@ fn render(args: &RenderArgs) -> Result<i32> {
         count_work: args.profile,
         hierarchy: HierarchyOptions { point_count, shadow_resolution: args.shadow_resolution, eta },
         show,
+        exposure: args.exposure.map(Exposure::Stops).unwrap_or(Exposure::Auto),
     };
     let mut renderer = Renderer::new(ctx, &scene, options)?;
     // A progress bar over every shading tile of every frame; indicatif hides it off a terminal.
@@ -582,7 +583,6 @@ fn render(args: &RenderArgs) -> Result<i32> {
     );
     renderer.progress = Some(bar.clone());
 
-    let exposure = args.exposure.map(Exposure::Stops).unwrap_or(Exposure::Auto);
     let every_frame = args.out.to_string_lossy().contains("{frame}");
     let base_lights = scene.lights.clone();
     let (centre, _) = crate::scene::bounding_sphere(&scene.mesh.positions);
@@ -593,19 +593,17 @@ fn render(args: &RenderArgs) -> Result<i32> {
         frames.push(renderer.render_frame(&scene)?);
         if every_frame {
             let path = frame_path(&args.out, index);
-            output::write_image(&path, &renderer.image()?, exposure)?;
+            renderer.write_image(&path)?;
             bar.suspend(|| eprintln!("wrote {}", path.display()));
         }
     }
     bar.finish_and_clear();
-    let image = renderer.image()?;
-    let work = renderer.work()?;
-    drop(renderer);
-
     if !every_frame {
-        output::write_image(&args.out, &image, exposure)?;
+        renderer.write_image(&args.out)?;
         eprintln!("wrote {} ({}x{}, {} frame(s))", args.out.display(), args.width, args.height, args.frames);
     }
+    let work = renderer.work()?;
+    drop(renderer);
 
     if frames.iter().any(|f| !f.is_empty()) {
         report_profile(&device_name, frames, args)?;

@@ -6,9 +6,10 @@ use crate::bad_input;
 use crate::error::Result;
 use crate::hierarchy::{Hierarchy, HierarchyOptions};
 use crate::materials::Material;
-use crate::output::HdrImage;
+use crate::output::{self, Exposure, HdrImage};
 use crate::passes::debug_view::{self, DebugConstants, DebugViewPass};
 use crate::passes::shade::{self, ShadeConstants, ShadeInputs, ShadePass, SubsurfaceParams, WorkCounters};
+use crate::passes::tonemap::{self, TonemapPass};
 use crate::physics::{Diffusion, GpuChannel, Model};
 use crate::scene::Scene;
 use crate::vk::{
@@ -81,6 +82,8 @@ pub struct FrameOptions {
     pub count_work: bool,
     pub hierarchy: HierarchyOptions,
     pub show: Show,
+    /// Of the tone-mapped 8-bit image (PNG); the HDR image is untouched.
+    pub exposure: Exposure,
 }
 
 pub struct Renderer {
@@ -104,6 +107,11 @@ pub struct Renderer {
     bounds: (Vec3, Vec3),
     color: Image,
     depth: Image,
+    tonemap: TonemapPass,
+    exposure: Exposure,
+    histogram: Buffer,
+    /// The tone-mapped image, one packed RGBA8 pixel per u32, read by the host.
+    ldr: Buffer,
     readback: Buffer,
     extent: Extent2D,
     pub ctx: Context,
@@ -112,7 +120,7 @@ pub struct Renderer {
 impl Renderer {
     /// Uploads the scene's mesh and creates the targets for `width` x `height` images.
     pub fn new(ctx: Context, scene: &Scene, options: FrameOptions) -> Result<Renderer> {
-        let FrameOptions { subsurface, width, height, profile, count_work, hierarchy, show } = options;
+        let FrameOptions { subsurface, width, height, profile, count_work, hierarchy, show, exposure } = options;
         if !(subsurface.epsilon.is_finite() && subsurface.epsilon >= 0.0) {
             return Err(bad_input!("--epsilon {}: must be a finite number ≥ 0", subsurface.epsilon));
         }
@@ -163,6 +171,20 @@ impl Renderer {
         let readback_bytes = width as u64 * height as u64 * 16;
         let readback =
             Buffer::new(&ctx, "readback", readback_bytes, BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)?;
+        let histogram = Buffer::new(
+            &ctx,
+            "luminance histogram",
+            tonemap::histogram_bytes(),
+            BufferUsageFlags::STORAGE_BUFFER | BufferUsageFlags::TRANSFER_DST,
+            MemoryLocation::GpuOnly,
+        )?;
+        let ldr = Buffer::new(
+            &ctx,
+            "tone-mapped image",
+            tonemap::ldr_bytes(width, height),
+            BufferUsageFlags::STORAGE_BUFFER,
+            MemoryLocation::GpuToCpu,
+        )?;
         let shade = ShadePass::new(&ctx)?;
         let hierarchy = Hierarchy::new(&ctx, &scene.mesh, &scene.lights, &hierarchy)?;
         let mut params = subsurface_params(&subsurface, scene.mm_per_unit, hierarchy.point_count);
@@ -199,6 +221,10 @@ impl Renderer {
             bounds: scene.mesh.bounds(),
             color,
             depth,
+            tonemap: TonemapPass::new(&ctx)?,
+            exposure,
+            histogram,
+            ldr,
             readback,
             extent,
             ctx,
@@ -308,8 +334,12 @@ impl Renderer {
             })?;
         }
         self.ctx.submit(self.profiler.as_mut(), |rec| {
+            rec.begin_scope("tone mapping");
+            self.tonemap.record(rec, &self.color, &self.histogram, &self.ldr, self.exposure)?;
+            rec.end_scope();
             rec.begin_scope("readback");
             rec.host_read(&self.work_counters)?;
+            rec.host_read(&self.ldr)?;
             rec.copy_image_to_buffer(&self.color, &self.readback)?;
             rec.end_scope();
             Ok(())
@@ -321,6 +351,22 @@ impl Renderer {
     /// fragment-shader atomics).
     pub fn work(&self) -> Result<WorkCounters> {
         Ok(self.work_counters.read::<WorkCounters>(1)?[0])
+    }
+
+    /// The last frame tone-mapped on the GPU (exposure, filmic curve, sRGB; alpha = coverage).
+    pub fn tone_mapped_image(&self) -> Result<image::RgbaImage> {
+        let (w, h) = (self.extent.width, self.extent.height);
+        output::rgba8_from_packed(w, h, &self.ldr.read::<u32>((w * h) as usize)?)
+    }
+
+    /// Writes the last frame: `.png` as tone-mapped on the GPU, `.exr` as linear radiance.
+    pub fn write_image(&self, path: &std::path::Path) -> Result<()> {
+        let ext = path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).unwrap_or_default();
+        if ext == "png" {
+            let image = self.tone_mapped_image()?;
+            return image.save(path).map_err(|e| crate::runtime!("cannot write {}: {e}", path.display()));
+        }
+        output::write_image(path, &self.image()?, self.exposure)
     }
 
     /// The last frame's linear radiance, read back from the GPU.

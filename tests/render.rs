@@ -155,3 +155,30 @@ fn spinning_light_writes_every_frame() {
     assert!(turn < 1e-3, "a whole turn must come back to the first frame: {turn}");
     assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 5, "one file per frame");
 }
+
+/// The PNG is tone-mapped on the GPU in the frame; it equals the CPU definition applied to the
+/// EXR (linear radiance) of the same frame, with automatic and with fixed exposure.
+#[test]
+fn png_is_the_tone_mapped_exr() {
+    for (name, exposure) in [("auto", None), ("fixed", Some("1.5"))] {
+        let (png, exr) = (output_dir().join(format!("tm-{name}.png")), output_dir().join(format!("tm-{name}.exr")));
+        for path in [&png, &exr] {
+            let mut args = vec!["render", "--validation", "--mesh", "torus", "--width", "40", "--height", "24"];
+            if let Some(e) = exposure {
+                args.extend_from_slice(&["--exposure", e]);
+            }
+            args.extend_from_slice(&["--out", path.to_str().unwrap()]);
+            let out = translucent(&args);
+            assert!(out.status.success(), "{}", stderr(&out));
+        }
+        let hdr = image::open(&exr).unwrap().into_rgba32f();
+        let hdr =
+            output::HdrImage { width: hdr.width(), height: hdr.height(), pixels: hdr.pixels().map(|p| p.0).collect() };
+        let stops = exposure.map(|e| output::Exposure::Stops(e.parse().unwrap())).unwrap_or(output::Exposure::Auto);
+        let expected = output::tonemap(&hdr, stops);
+        let actual = image::open(&png).unwrap().into_rgba8();
+        let worst = actual.as_raw().iter().zip(expected.as_raw()).map(|(a, b)| a.abs_diff(*b)).max().unwrap();
+        println!("GPU tone mapping ({name} exposure) vs CPU: worst difference {worst}/255");
+        assert!(worst <= 1, "{name}: {worst}");
+    }
+}
