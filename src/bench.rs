@@ -1,5 +1,10 @@
-//! `translucent bench`: GPU time per pass (timestamps) for several sample counts and meshes, as a
-//! Markdown table. Frame 1 warms the pipelines up; the table reports the mean over the rest.
+//! `translucent bench`: GPU time per pass (timestamps) as Markdown tables:
+//! 1. every pass of the frame for several sample counts and meshes, with the shading work per
+//!    pixel and peak memory;
+//! 2. the hierarchy against brute force (speed-up of the shade pass and relative RMSE);
+//! 3. an epsilon sweep (shade time and error), which justifies the default.
+//!
+//! Frame 1 of each configuration warms the pipelines up; tables report the mean over the rest.
 
 use glam::Vec3;
 
@@ -7,7 +12,9 @@ use crate::error::Result;
 use crate::frame::{FrameOptions, Renderer, Show, SubsurfaceOptions};
 use crate::hierarchy::{self, HierarchyOptions};
 use crate::mesh::Mesh;
-use crate::profiling::{summary, ProfileReport, Scope};
+use crate::output::{Exposure, HdrImage};
+use crate::passes::shade::WorkCounters;
+use crate::profiling::{summary, PassStats, ProfileReport, Scope};
 use crate::scene::{bounding_sphere, Camera, Light, Scene};
 use crate::vk::{Context, ContextOptions};
 
@@ -17,75 +24,204 @@ pub struct BenchOptions {
     pub width: u32,
     pub height: u32,
     pub frames: u32,
+    /// Image size (square) of the brute-force comparison and the epsilon sweep; 0 skips them.
+    pub accuracy_size: u32,
+    /// Sample counts of the brute-force comparison.
+    pub accuracy_samples: Vec<u32>,
+    pub epsilons: Vec<f32>,
     pub context: ContextOptions,
+}
+
+/// The default scene's set-up (back-lit marble) for `mesh`.
+fn scene(spec: &str) -> Result<Scene> {
+    let mesh = Mesh::from_spec(spec)?;
+    let (centre, radius) = bounding_sphere(&mesh.positions);
+    let camera = Camera::framing(centre, radius, 40.0, Vec3::new(0.3, 0.3, 1.0));
+    let lights = vec![Light::Directional { toward: Vec3::new(-0.3, 0.7, -0.65), irradiance: Vec3::ONE }];
+    Ok(Scene { mesh, camera, lights, mm_per_unit: 10.0 })
+}
+
+struct Run {
+    device: String,
+    passes: Vec<PassStats>,
+    work: WorkCounters,
+    image: HdrImage,
+}
+
+/// Renders `frames` frames (the first a warm-up) and returns the mean pass times of the rest.
+#[allow(clippy::too_many_arguments)]
+fn run_one(
+    context: &ContextOptions,
+    scene: &Scene,
+    n: u32,
+    size: (u32, u32),
+    frames: u32,
+    epsilon: f32,
+    brute_force: bool,
+    specular: bool,
+) -> Result<Run> {
+    let ctx = Context::new(context)?;
+    hierarchy::check_point_count(&ctx, n)?;
+    let device = format!("{} ({})", ctx.info.name, ctx.info.driver);
+    let options = FrameOptions {
+        subsurface: SubsurfaceOptions {
+            material: crate::materials::Material::find("marble")?,
+            model: crate::physics::Model::Directional,
+            diffusion: crate::physics::Diffusion::Classical,
+            epsilon,
+            brute_force,
+            specular,
+            roughness: 0.35,
+        },
+        width: size.0,
+        height: size.1,
+        profile: true,
+        count_work: true,
+        hierarchy: HierarchyOptions { point_count: n, shadow_resolution: 1024, eta: 1.5 },
+        show: Show::Shading,
+        exposure: Exposure::Auto,
+    };
+    let mut renderer = Renderer::new(ctx, scene, options)?;
+    let mut timed = Vec::new();
+    for _ in 0..frames.max(2) {
+        let scopes = renderer.render_frame(scene)?;
+        timed
+            .push(scopes.into_iter().map(|s| Scope { name: s.name, begin_ns: s.begin_ns, end_ns: s.end_ns }).collect());
+    }
+    timed.remove(0);
+    let passes = summary(&ProfileReport { device: device.clone(), frames: timed });
+    Ok(Run { device, passes, work: renderer.work()?, image: renderer.image()? })
+}
+
+fn pass_ms(run: &Run, name: &str) -> f64 {
+    run.passes.iter().find(|p| p.name == name).map(|p| p.mean_ms).unwrap_or(0.0)
+}
+
+/// sqrt(Σ(a − b)² / Σ b²) over covered pixels and all channels.
+pub fn relative_rmse(a: &HdrImage, b: &HdrImage) -> f64 {
+    let (mut num, mut den) = (0.0f64, 0.0f64);
+    for (p, q) in a.pixels.iter().zip(&b.pixels) {
+        if q[3] > 0.0 {
+            for c in 0..3 {
+                num += (p[c] as f64 - q[c] as f64).powi(2);
+                den += (q[c] as f64).powi(2);
+            }
+        }
+    }
+    if den > 0.0 {
+        (num / den).sqrt()
+    } else {
+        0.0
+    }
+}
+
+/// Peak resident memory of this process (VmHWM) in MiB; on lavapipe GPU memory is host memory.
+fn peak_rss_mib() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib / 1024.0)
+}
+
+fn mesh_name(spec: &str) -> &str {
+    std::path::Path::new(spec).file_stem().and_then(|s| s.to_str()).unwrap_or(spec)
 }
 
 pub fn run(options: &BenchOptions) -> Result<String> {
     let mut out = String::new();
+    let per_pixel = |w: &WorkCounters, sum: u32| if w.pixels > 0 { sum as f64 / w.pixels as f64 } else { 0.0 };
+
+    // 1. Every pass, per mesh and sample count.
     let mut header_done = false;
     for spec in &options.meshes {
-        let mesh = Mesh::from_spec(spec)?;
-        let (centre, radius) = bounding_sphere(&mesh.positions);
-        let camera = Camera::framing(centre, radius, 40.0, Vec3::new(0.3, 0.3, 1.0));
-        let lights = vec![Light::Directional { toward: Vec3::new(-0.5, 0.8, 0.6), irradiance: Vec3::ONE }];
-        let scene = Scene { mesh, camera, lights, mm_per_unit: 10.0 };
+        let scene = scene(spec)?;
         for &n in &options.samples {
-            let ctx = Context::new(&options.context)?;
-            let device = format!("{} ({})", ctx.info.name, ctx.info.driver);
-            if hierarchy::check_point_count(&ctx, n).is_err() {
-                out += &format!("| {spec} | {n} | — exceeds this device's storage-buffer range |\n");
-                continue;
-            }
-            let frame_options = FrameOptions {
-                subsurface: SubsurfaceOptions {
-                    material: crate::materials::Material::find("marble")?,
-                    model: crate::physics::Model::Directional,
-                    diffusion: crate::physics::Diffusion::Classical,
-                    epsilon: 0.1,
-                    brute_force: false,
-                    specular: true,
-                    roughness: 0.35,
-                },
-                width: options.width,
-                height: options.height,
-                profile: true,
-                count_work: false,
-                hierarchy: HierarchyOptions { point_count: n, shadow_resolution: 1024, eta: 1.3 },
-                show: Show::Shading,
-                exposure: crate::output::Exposure::Auto,
+            let size = (options.width, options.height);
+            let run = match run_one(&options.context, &scene, n, size, options.frames, 0.1, false, true) {
+                Ok(r) => r,
+                Err(e) => {
+                    out += &format!("| {} | {n} | — {e} |\n", mesh_name(spec));
+                    continue;
+                }
             };
-            let mut renderer = Renderer::new(ctx, &scene, frame_options)?;
-            let mut frames = Vec::new();
-            for _ in 0..options.frames.max(2) {
-                let scopes = renderer.render_frame(&scene)?;
-                frames.push(
-                    scopes
-                        .into_iter()
-                        .map(|s| Scope { name: s.name, begin_ns: s.begin_ns, end_ns: s.end_ns })
-                        .collect(),
-                );
-            }
-            frames.remove(0);
-            let rows = summary(&ProfileReport { device: device.clone(), frames });
             if !header_done {
                 out += &format!(
-                    "Device: {device}; {}x{}, mean of {} frames after one warm-up frame.\n\n",
+                    "### Every pass\n\nDevice: {}; {}x{}, back-lit marble, directional dipole, ε = 0.1; mean of {} frame(s) after one warm-up frame. Peak RSS is the process's high-water mark so far (on lavapipe GPU memory is host memory).\n\n",
+                    run.device,
                     options.width,
                     options.height,
                     options.frames.max(2) - 1
                 );
                 out += "| mesh | points | ";
-                out += &rows.iter().map(|r| format!("{} ms", r.name)).collect::<Vec<_>>().join(" | ");
-                out += " | hierarchy MiB |\n|---|---:|";
-                out += &"---:|".repeat(rows.len() + 1);
+                out += &run.passes.iter().map(|r| format!("{} ms", r.name)).collect::<Vec<_>>().join(" | ");
+                out += " | nodes/px | points/px | hierarchy MiB | peak RSS MiB |\n|---|---:|";
+                out += &"---:|".repeat(run.passes.len() + 4);
                 out += "\n";
                 header_done = true;
             }
-            let name = std::path::Path::new(spec).file_stem().and_then(|s| s.to_str()).unwrap_or(spec);
-            out += &format!("| {name} | {n} | ");
-            out += &rows.iter().map(|r| format!("{:.2}", r.mean_ms)).collect::<Vec<_>>().join(" | ");
-            out += &format!(" | {:.1} |\n", hierarchy::bytes_used(n) as f64 / (1 << 20) as f64);
-            eprintln!("bench: {name} N={n} done");
+            out += &format!("| {} | {n} | ", mesh_name(spec));
+            out += &run.passes.iter().map(|r| format!("{:.2}", r.mean_ms)).collect::<Vec<_>>().join(" | ");
+            out += &format!(
+                " | {:.1} | {:.1} | {:.1} | {:.0} |\n",
+                per_pixel(&run.work, run.work.node_sum),
+                per_pixel(&run.work, run.work.point_sum),
+                hierarchy::bytes_used(n) as f64 / (1 << 20) as f64,
+                peak_rss_mib().unwrap_or(f64::NAN)
+            );
+            eprintln!("bench: {} N={n} done", mesh_name(spec));
+        }
+    }
+    if options.accuracy_size == 0 {
+        return Ok(out);
+    }
+
+    // 2. The hierarchy against brute force, and 3. the epsilon sweep, on the first mesh.
+    let spec = &options.meshes[0];
+    let scene = scene(spec)?;
+    let size = (options.accuracy_size, options.accuracy_size);
+    out += &format!(
+        "\n### Hierarchy against brute force\n\n{} at {s}x{s}, subsurface term only, ε = 0.1; shade pass time (mean of {} frame(s) after a warm-up), relative RMSE over covered pixels.\n\n| points | brute force ms | hierarchy ms | speed-up | BSSRDF evaluations/px (brute / tree) | nodes visited/px | relative RMSE |\n|---:|---:|---:|---:|---:|---:|---:|\n",
+        mesh_name(spec),
+        options.frames.max(2) - 1,
+        s = options.accuracy_size
+    );
+    let mut sweep_reference = None;
+    for &n in &options.accuracy_samples {
+        let brute = run_one(&options.context, &scene, n, size, options.frames, 0.1, true, false)?;
+        let tree = run_one(&options.context, &scene, n, size, options.frames, 0.1, false, false)?;
+        let (b, t) = (pass_ms(&brute, "shade"), pass_ms(&tree, "shade"));
+        // A node used whole is one evaluation, like a point.
+        let tree_evaluations = per_pixel(&tree.work, tree.work.point_sum + tree.work.node_sum);
+        out += &format!(
+            "| {n} | {b:.1} | {t:.1} | {:.1}× | {:.0} / {:.0} | {:.1} | {:.3}% |\n",
+            b / t,
+            per_pixel(&brute.work, brute.work.point_sum),
+            tree_evaluations,
+            per_pixel(&tree.work, tree.work.node_sum),
+            100.0 * relative_rmse(&tree.image, &brute.image)
+        );
+        eprintln!("bench: brute force N={n} done");
+        if sweep_reference.is_none() {
+            sweep_reference = Some((n, brute));
+        }
+    }
+    if let Some((n, brute)) = sweep_reference {
+        out += &format!(
+            "\n### Epsilon sweep\n\n{} at {s}x{s}, {n} points, subsurface term only; brute force shades in {:.1} ms.\n\n| ε | shade ms | nodes visited/px | points evaluated/px | relative RMSE |\n|---:|---:|---:|---:|---:|\n",
+            mesh_name(spec),
+            pass_ms(&brute, "shade"),
+            s = options.accuracy_size
+        );
+        for &eps in &options.epsilons {
+            let tree = run_one(&options.context, &scene, n, size, options.frames, eps, false, false)?;
+            out += &format!(
+                "| {eps} | {:.1} | {:.1} | {:.1} | {:.3}% |\n",
+                pass_ms(&tree, "shade"),
+                per_pixel(&tree.work, tree.work.node_sum),
+                per_pixel(&tree.work, tree.work.point_sum),
+                100.0 * relative_rmse(&tree.image, &brute.image)
+            );
+            eprintln!("bench: epsilon {eps} done");
         }
     }
     Ok(out)

@@ -44,15 +44,24 @@ pub struct BenchArgs {
     /// Meshes (built-in names or OBJ paths); the bunny is used when installed.
     #[arg(long, value_delimiter = ',')]
     pub meshes: Option<Vec<String>>,
-    /// Sample counts.
-    #[arg(long, value_delimiter = ',', default_values = ["16384", "65536", "262144", "1048576"])]
+    /// Sample counts of the per-pass table.
+    #[arg(long, value_delimiter = ',', default_values = ["16384", "65536", "262144"])]
     pub samples: Vec<u32>,
+    /// Image size (square) of the brute-force comparison and the epsilon sweep; 0 skips them.
+    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(0..=4096))]
+    pub accuracy_size: u32,
+    /// Sample counts of the brute-force comparison (the first is also the epsilon sweep's).
+    #[arg(long, value_delimiter = ',', default_values = ["16384", "65536", "262144"])]
+    pub accuracy_samples: Vec<u32>,
+    /// Epsilons of the sweep.
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true, default_values = ["0.4", "0.2", "0.1", "0.05", "0.025"])]
+    pub epsilons: Vec<f32>,
     #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=16384))]
     pub width: u32,
     #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=16384))]
     pub height: u32,
     /// Frames per configuration (the first is a warm-up).
-    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(2..=1000))]
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(2..=1000))]
     pub frames: u32,
     #[command(flatten)]
     pub device: DeviceArgs,
@@ -383,6 +392,9 @@ pub fn run(cli: Cli) -> Result<i32> {
                 width: args.width,
                 height: args.height,
                 frames: args.frames,
+                accuracy_size: args.accuracy_size,
+                accuracy_samples: args.accuracy_samples.clone(),
+                epsilons: args.epsilons.clone(),
                 context: args.device.options(),
             };
             print!("{}", crate::bench::run(&options)?);

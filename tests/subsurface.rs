@@ -308,7 +308,9 @@ fn shadowed_slab_quadrature(model: &str, travel: f64) -> f64 {
     let (xo, no) = (DVec3::new(2.0, 1.0, 0.0), DVec3::Y);
     let h = 0.05;
     let side = -12.0 * travel;
-    let faces: [(DVec3, Box<dyn Fn(f64, f64) -> DVec3>, f64, f64); 2] = [
+    // (normal, cell centre from coordinates along the face, extents)
+    type Face = (DVec3, Box<dyn Fn(f64, f64) -> DVec3>, f64, f64);
+    let faces: [Face; 2] = [
         (DVec3::NEG_Y, Box::new(|u, v| DVec3::new(u - 12.0, -1.0, v - 6.0)), 12.0, 12.0),
         (DVec3::X * -travel, Box::new(move |u, v| DVec3::new(side, u - 1.0, v - 6.0)), 2.0, 12.0),
     ];
