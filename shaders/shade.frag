@@ -11,6 +11,11 @@
 #include "lights.glsl"
 #include "microfacet.glsl"
 
+// Depth test before shading: the shader writes the work counters, and without this a driver may
+// run it for every layer of the mesh and test depth after (llvmpipe did: a 64x64 sphere counted
+// 6144 shaded pixels, its back faces walked the tree too).
+layout(early_fragment_tests) in;
+
 layout(location = 0) in vec3 world_position;
 layout(location = 1) in vec3 world_normal;
 layout(location = 0) out vec4 radiance;
