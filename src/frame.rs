@@ -16,6 +16,14 @@ use crate::vk::{
     self, Buffer, BufferUsageFlags, Context, Extent2D, GpuProfiler, Image, ImageUsageFlags, MemoryLocation, TimedScope,
 };
 
+/// Shading units for the next submission after `batch` units took `seconds`: as many as fit in
+/// SUBMISSION_TARGET_S at that pace, growing at most ×2 per step, within [1, MAX_UNITS_PER_SUBMISSION].
+fn next_batch_size(batch: usize, seconds: f64) -> usize {
+    let per_unit = seconds / batch.max(1) as f64;
+    let fit = (SUBMISSION_TARGET_S / per_unit.max(1e-9)).floor() as usize;
+    fit.clamp(1, (2 * batch).clamp(1, MAX_UNITS_PER_SUBMISSION))
+}
+
 fn subsurface_params(o: &SubsurfaceOptions, mm_per_unit: f32, point_count: u32) -> SubsurfaceParams {
     let channel = |c: usize| GpuChannel::from(&o.material.channel(c).constants(o.diffusion));
     SubsurfaceParams {
@@ -46,6 +54,10 @@ const TILE: u32 = 128;
 /// submissions before: short enough for GPU watchdogs (about 2 s on desktop drivers) and for a
 /// moving progress bar, while a fast GPU still shades a frame in one or two submissions.
 const SUBMISSION_TARGET_S: f64 = 0.2;
+
+/// At most this many shading units per submission: each draw takes a descriptor set from the
+/// submission's pool (`SETS_PER_SUBMIT` = 512 in src/vk/commands.rs).
+const MAX_UNITS_PER_SUBMISSION: usize = 256;
 
 /// What to draw over the shaded mesh for debugging.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -297,10 +309,7 @@ impl Renderer {
             if let Some(bar) = &self.progress {
                 bar.inc(batch.len() as u64);
             }
-            // Grow or shrink the next batch toward the target time, at most ×2 per step.
-            let per_unit = seconds / batch.len() as f64;
-            let fit = (SUBMISSION_TARGET_S / per_unit.max(1e-9)).floor() as usize;
-            self.units_per_submission = fit.clamp(1, 2 * batch.len());
+            self.units_per_submission = next_batch_size(batch.len(), seconds);
         }
 
         if self.show == Show::Samples {
@@ -374,5 +383,20 @@ impl Renderer {
         let count = (self.extent.width * self.extent.height) as usize;
         let pixels = self.readback.read::<[f32; 4]>(count)?;
         Ok(HdrImage { width: self.extent.width, height: self.extent.height, pixels })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn submissions_grow_and_shrink_toward_the_target_time() {
+        assert_eq!(next_batch_size(1, 1e-6), 2, "fast: at most doubles");
+        assert_eq!(next_batch_size(200, 1e-6), MAX_UNITS_PER_SUBMISSION, "never past the descriptor pool");
+        assert_eq!(next_batch_size(8, 0.1), 16);
+        assert_eq!(next_batch_size(8, 0.8), 2, "slow: shrinks to what fits");
+        assert_eq!(next_batch_size(1, 30.0), 1, "never below one unit");
+        assert_eq!(next_batch_size(4, 0.0), 8);
     }
 }

@@ -548,19 +548,7 @@ impl<'a> Recorder<'a> {
     pub fn copy_image_to_buffer(&mut self, src: &Image, dst: &Buffer) -> Result<()> {
         self.use_image(src, Access::TRANSFER_READ)?;
         self.use_buffer(dst, Access { layout: vk::ImageLayout::UNDEFINED, ..Access::TRANSFER_WRITE })?;
-        let region = [vk::BufferImageCopy {
-            buffer_offset: 0,
-            buffer_row_length: 0,
-            buffer_image_height: 0,
-            image_subresource: vk::ImageSubresourceLayers {
-                aspect_mask: aspect_of(src.format),
-                mip_level: 0,
-                base_array_layer: 0,
-                layer_count: 1,
-            },
-            image_offset: vk::Offset3D::default(),
-            image_extent: vk::Extent3D { width: src.extent.width, height: src.extent.height, depth: 1 },
-        }];
+        let region = [layer0_region(src)];
         unsafe {
             self.device().cmd_copy_image_to_buffer(
                 self.cmd,
@@ -588,19 +576,7 @@ impl<'a> Recorder<'a> {
         self.use_buffer(src, Access { layout: vk::ImageLayout::UNDEFINED, ..Access::TRANSFER_READ })?;
         self.discard_image(dst);
         self.use_image(dst, Access::TRANSFER_WRITE)?;
-        let region = [vk::BufferImageCopy {
-            buffer_offset: 0,
-            buffer_row_length: 0,
-            buffer_image_height: 0,
-            image_subresource: vk::ImageSubresourceLayers {
-                aspect_mask: aspect_of(dst.format),
-                mip_level: 0,
-                base_array_layer: 0,
-                layer_count: 1,
-            },
-            image_offset: vk::Offset3D::default(),
-            image_extent: vk::Extent3D { width: dst.extent.width, height: dst.extent.height, depth: 1 },
-        }];
+        let region = [layer0_region(dst)];
         // SAFETY: the image is in TRANSFER_DST_OPTIMAL (barrier above); the buffer holds the region.
         unsafe {
             self.device().cmd_copy_buffer_to_image(
@@ -640,6 +616,23 @@ impl<'a> Recorder<'a> {
                 self.ctx.device().cmd_write_timestamp2(self.cmd, vk::PipelineStageFlags2::ALL_COMMANDS, pool, query)
             };
         }
+    }
+}
+
+/// All of layer 0 of `image`, tightly packed in a buffer from offset 0.
+fn layer0_region(image: &Image) -> vk::BufferImageCopy {
+    vk::BufferImageCopy {
+        buffer_offset: 0,
+        buffer_row_length: 0,
+        buffer_image_height: 0,
+        image_subresource: vk::ImageSubresourceLayers {
+            aspect_mask: aspect_of(image.format),
+            mip_level: 0,
+            base_array_layer: 0,
+            layer_count: 1,
+        },
+        image_offset: vk::Offset3D::default(),
+        image_extent: vk::Extent3D { width: image.extent.width, height: image.extent.height, depth: 1 },
     }
 }
 
