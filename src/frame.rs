@@ -48,7 +48,7 @@ fn subsurface_params(o: &SubsurfaceOptions, mm_per_unit: f32, point_count: u32) 
 const MAX_SCOPES: u32 = 4096;
 
 /// Shading is cut into tiles of this many pixels square (and, for brute force, ranges of points).
-const TILE: u32 = 128;
+pub const DEFAULT_TILE: u32 = 128;
 
 /// Each shading submission takes as many tiles as fit in about this much time, learnt from the
 /// submissions before: short enough for GPU watchdogs (about 2 s on desktop drivers) and for a
@@ -107,6 +107,8 @@ pub struct Renderer {
     work_counters: Buffer,
     brute_force: bool,
     shade: ShadePass,
+    /// Side of the shading tiles in pixels.
+    tile: u32,
     /// Shading units per submission, adapted to SUBMISSION_TARGET_S.
     units_per_submission: usize,
     /// Advanced by one per shading unit done, when set (the CLI sets one on a terminal).
@@ -223,6 +225,7 @@ impl Renderer {
             work_counters,
             brute_force: subsurface.brute_force,
             shade,
+            tile: DEFAULT_TILE,
             units_per_submission: 1,
             progress: None,
             debug_view: DebugViewPass::new(&ctx)?,
@@ -250,7 +253,12 @@ impl Renderer {
 
     fn units(&self) -> Vec<shade::ShadeUnit> {
         let brute_force_points = self.brute_force.then_some(self.hierarchy.point_count);
-        shade::shade_units(self.extent.width, self.extent.height, TILE, brute_force_points)
+        shade::shade_units(self.extent.width, self.extent.height, self.tile, brute_force_points)
+    }
+
+    /// Shades in tiles of `tile` pixels square from the next frame on (tests compare tilings).
+    pub fn set_tile_size(&mut self, tile: u32) {
+        self.tile = tile.max(1);
     }
 
     /// Renders one frame and returns its GPU timestamp scopes (empty without a profiler). The
