@@ -182,3 +182,38 @@ fn png_is_the_tone_mapped_exr() {
         assert!(worst <= 1, "{name}: {worst}");
     }
 }
+
+/// The layer forced from outside, as users and reviewers run it, with synchronization validation
+/// and best practices: every kind of frame is clean (any message makes the exit code 1).
+#[test]
+fn forced_layer_with_best_practices_is_clean() {
+    let out = output_dir().join("forced.png");
+    let out = out.to_str().unwrap();
+    let tree = output_dir().join("forced-tree.exr");
+    #[rustfmt::skip]
+    let cases: [&[&str]; 4] = [
+        &["--frames", "2", "--spin-light", "30", "--profile"],
+        &["--mesh", "torus", "--brute-force", "--samples", "9000", "--light", "point:2,2,2:3", "--light", "dir:0,1,0"],
+        &["--mesh", "sphere", "--show", "samples", "--exposure", "1"],
+        &["--mesh", "sphere", "--show", "tree", "--level", "3", "--out", tree.to_str().unwrap()],
+    ];
+    for extra in cases {
+        let mut args = vec!["render", "--width", "40", "--height", "30"];
+        args.extend_from_slice(extra);
+        if !extra.contains(&"--out") {
+            args.extend_from_slice(&["--out", out]);
+        }
+        let result = std::process::Command::new(env!("CARGO_BIN_EXE_translucent"))
+            .args(&args)
+            .env("VK_INSTANCE_LAYERS", "VK_LAYER_KHRONOS_validation")
+            .env(
+                "VK_LAYER_ENABLES",
+                "VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT:VK_VALIDATION_FEATURE_ENABLE_BEST_PRACTICES_EXT",
+            )
+            .output()
+            .unwrap();
+        let err = stderr(&result);
+        assert!(result.status.success(), "{extra:?}: exit {:?}\n{err}", result.status.code());
+        assert!(!err.contains("vulkan validation"), "{extra:?}:\n{err}");
+    }
+}

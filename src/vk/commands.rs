@@ -26,6 +26,10 @@ pub(crate) struct Commands {
 
 const SETS_PER_SUBMIT: u32 = 512;
 
+/// Timestamps are written once all earlier commands are done. BOTTOM_OF_PIPE means that for a
+/// timestamp, as ALL_COMMANDS does, without the best-practices layer's warning about the latter.
+const TIMESTAMP_STAGE: vk::PipelineStageFlags2 = vk::PipelineStageFlags2::BOTTOM_OF_PIPE;
+
 impl Commands {
     pub(crate) fn new(device: &ash::Device, queue_family: u32) -> Result<Commands> {
         // SAFETY: valid device; each object is destroyed in `destroy`.
@@ -600,9 +604,7 @@ impl<'a> Recorder<'a> {
         if let Some(p) = self.profiler.as_deref_mut() {
             if let Some((pool, query, index)) = p.open(name) {
                 // SAFETY: the query was reset on the host before this submission.
-                unsafe {
-                    self.ctx.device().cmd_write_timestamp2(self.cmd, vk::PipelineStageFlags2::ALL_COMMANDS, pool, query)
-                };
+                unsafe { self.ctx.device().cmd_write_timestamp2(self.cmd, TIMESTAMP_STAGE, pool, query) };
                 self.open_scopes.push(index);
             }
         }
@@ -612,9 +614,7 @@ impl<'a> Recorder<'a> {
         let Some(index) = self.open_scopes.pop() else { return };
         if let Some(p) = self.profiler.as_deref_mut() {
             let (pool, query) = p.close(index);
-            unsafe {
-                self.ctx.device().cmd_write_timestamp2(self.cmd, vk::PipelineStageFlags2::ALL_COMMANDS, pool, query)
-            };
+            unsafe { self.ctx.device().cmd_write_timestamp2(self.cmd, TIMESTAMP_STAGE, pool, query) };
         }
     }
 }

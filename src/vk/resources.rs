@@ -48,9 +48,11 @@ impl Access {
         ),
         vk::ImageLayout::GENERAL,
     );
+    // SHADER_READ rather than sync2's narrower SHADER_SAMPLED_READ: the best-practices layer
+    // (1.3.239) expects SHADER_READ with SHADER_READ_ONLY_OPTIMAL and warns otherwise.
     pub const COMPUTE_SAMPLED: Access = Access::new(
         vk::PipelineStageFlags2::COMPUTE_SHADER,
-        vk::AccessFlags2::SHADER_SAMPLED_READ,
+        vk::AccessFlags2::SHADER_READ,
         vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
     );
     pub const FRAGMENT_READ: Access = Access::new(
@@ -67,7 +69,7 @@ impl Access {
     );
     pub const FRAGMENT_SAMPLED: Access = Access::new(
         vk::PipelineStageFlags2::FRAGMENT_SHADER,
-        vk::AccessFlags2::SHADER_SAMPLED_READ,
+        vk::AccessFlags2::SHADER_READ,
         vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
     );
     pub const VERTEX_READ: Access = Access::new(
