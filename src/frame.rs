@@ -107,6 +107,8 @@ pub struct Renderer {
     work_counters: Buffer,
     brute_force: bool,
     shade: ShadePass,
+    /// The lights the hierarchy was last given (re-sent only when they change).
+    lights: Vec<crate::scene::Light>,
     /// Side of the shading tiles in pixels.
     tile: u32,
     /// Shading units per submission, adapted to SUBMISSION_TARGET_S.
@@ -225,6 +227,7 @@ impl Renderer {
             work_counters,
             brute_force: subsurface.brute_force,
             shade,
+            lights: scene.lights.clone(),
             tile: DEFAULT_TILE,
             units_per_submission: 1,
             progress: None,
@@ -268,7 +271,10 @@ impl Renderer {
         let view_projection = scene.camera.view_projection(aspect, self.bounds);
         let constants =
             ShadeConstants { view_projection, eye: scene.camera.eye.extend(1.0), point_range: glam::UVec4::ZERO };
-        self.hierarchy.set_lights(&scene.mesh, &scene.lights)?;
+        if scene.lights != self.lights {
+            self.hierarchy.set_lights(&scene.mesh, &scene.lights)?;
+            self.lights = scene.lights.clone();
+        }
         let inputs = ShadeInputs {
             color: &self.color,
             depth: &self.depth,
