@@ -530,6 +530,12 @@ fn check_output_path(path: &std::path::Path, flag: &str, allowed: &[&str]) -> Re
     if !allowed.contains(&ext.as_str()) {
         return Err(bad_input!("{flag} {}: the extension must be one of .{}", path.display(), allowed.join(", .")));
     }
+    // Found out before a long render, not after it.
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        if !dir.is_dir() {
+            return Err(bad_input!("{flag} {}: the folder {} does not exist", path.display(), dir.display()));
+        }
+    }
     Ok(())
 }
 

@@ -74,6 +74,15 @@ fn bad_flag_values() {
 }
 
 #[test]
+fn output_folder_must_exist() {
+    let result = translucent(&["render", "--width", "8", "--height", "8", "--out", "/nonexistent/dir/x.png"]);
+    assert_eq!(result.status.code(), Some(2), "{}", stderr(&result));
+    assert!(stderr(&result).contains("/nonexistent/dir"), "{}", stderr(&result));
+    let result = translucent(&["render", "--width", "8", "--height", "8", "--profile-out", "/nonexistent/p.json"]);
+    assert_eq!(result.status.code(), Some(2), "{}", stderr(&result));
+}
+
+#[test]
 fn bad_output_extension() {
     let result = translucent(&["render", "--validation", "--width", "8", "--height", "8", "--out", "picture.bmp"]);
     assert_eq!(result.status.code(), Some(2));
