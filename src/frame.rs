@@ -204,7 +204,7 @@ impl Renderer {
         let shade = ShadePass::new(&ctx)?;
         let hierarchy = Hierarchy::new(&ctx, &scene.mesh, &scene.lights, &hierarchy)?;
         let mut params = subsurface_params(&subsurface, scene.mm_per_unit, hierarchy.point_count);
-        params.count_work = (count_work && ctx.has_fragment_atomics) as u32;
+        params.count_work = count_work as u32;
         let work_counters = Buffer::new(
             &ctx,
             "work counters",
@@ -370,8 +370,7 @@ impl Renderer {
         Ok(self.profiler.as_mut().map(|p| p.take_scopes()).unwrap_or_default())
     }
 
-    /// Work of the last frame's shading per pixel (zeros unless profiling on a device with
-    /// fragment-shader atomics).
+    /// Work of the last frame's shading per pixel (zeros unless `count_work` was set).
     pub fn work(&self) -> Result<WorkCounters> {
         Ok(self.work_counters.read::<WorkCounters>(1)?[0])
     }

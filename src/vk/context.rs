@@ -114,8 +114,6 @@ pub struct Context {
     /// Bits of a timestamp that are valid on the queue; 0 means no timestamps.
     pub timestamp_valid_bits: u32,
     pub has_shader_int64: bool,
-    /// Fragment shaders may write storage buffers (the per-pixel work counters of `--profile`).
-    pub has_fragment_atomics: bool,
     counts: Arc<ValidationCounts>,
     pub validation: bool,
     pub(crate) commands: super::commands::CommandsCell,
@@ -440,6 +438,10 @@ impl Context {
         if have12.host_query_reset == vk::FALSE {
             missing.push("hostQueryReset");
         }
+        if have10.fragment_stores_and_atomics == vk::FALSE {
+            // The shade pass's fragment shader writes its work counters (a storage buffer).
+            missing.push("fragmentStoresAndAtomics");
+        }
         if !missing.is_empty() {
             return Err(fail(
                 &debug,
@@ -448,10 +450,8 @@ impl Context {
         }
         let has_shader_int64 = have10.shader_int64 == vk::TRUE;
 
-        let has_fragment_atomics = have10.fragment_stores_and_atomics == vk::TRUE;
-        let features10 = vk::PhysicalDeviceFeatures::default()
-            .shader_int64(has_shader_int64)
-            .fragment_stores_and_atomics(has_fragment_atomics);
+        let features10 =
+            vk::PhysicalDeviceFeatures::default().shader_int64(has_shader_int64).fragment_stores_and_atomics(true);
         let mut features12 = vk::PhysicalDeviceVulkan12Features::default()
             .host_query_reset(true)
             .vulkan_memory_model(true)
@@ -515,7 +515,6 @@ impl Context {
             info,
             timestamp_valid_bits,
             has_shader_int64,
-            has_fragment_atomics,
             counts,
             validation,
             commands: std::cell::RefCell::new(commands),
