@@ -592,13 +592,14 @@ fn render(args: &RenderArgs) -> Result<i32> {
         exposure: args.exposure.map(Exposure::Stops).unwrap_or(Exposure::Auto),
     };
     let mut renderer = Renderer::new(ctx, &scene, options)?;
-    // A progress bar over every shading tile of every frame; indicatif hides it off a terminal.
-    let bar = indicatif::ProgressBar::new(args.frames as u64 * renderer.shading_units() as u64);
+    // A progress bar over the shading of every frame; indicatif hides it off a terminal.
+    let bar = indicatif::ProgressBar::new(Renderer::progress_length(args.frames));
     bar.set_style(
-        indicatif::ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} tiles, {eta} left")
+        indicatif::ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {percent}% of {msg}, {eta} left")
             .map_err(|e| runtime!("progress bar: {e}"))?
             .progress_chars("=> "),
     );
+    bar.set_message(format!("{} frame(s)", args.frames));
     renderer.progress = Some(bar.clone());
 
     let every_frame = args.out.to_string_lossy().contains("{frame}");

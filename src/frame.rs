@@ -24,6 +24,16 @@ fn next_batch_size(batch: usize, seconds: f64) -> usize {
     fit.clamp(1, (2 * batch).clamp(1, MAX_UNITS_PER_SUBMISSION))
 }
 
+/// Whether the next frame shades the whole image as one tile: once a frame's shading took one
+/// submission of under a quarter of SUBMISSION_TARGET_S, and for as long as it stays under the target.
+fn shade_whole_frame(whole_frame: bool, submissions: usize, seconds: f64) -> bool {
+    if whole_frame {
+        seconds < SUBMISSION_TARGET_S
+    } else {
+        submissions == 1 && seconds < SUBMISSION_TARGET_S / 4.0
+    }
+}
+
 fn subsurface_params(o: &SubsurfaceOptions, mm_per_unit: f32, point_count: u32) -> SubsurfaceParams {
     let channel = |c: usize| GpuChannel::from(&o.material.channel(c).constants(o.diffusion));
     SubsurfaceParams {
@@ -111,6 +121,12 @@ pub struct Renderer {
     lights: Vec<crate::scene::Light>,
     /// Side of the shading tiles in pixels.
     tile: u32,
+    /// Shade the whole image as one tile: set once a frame's shading fits one short submission,
+    /// since every tile draws the whole mesh again (unless a tile size was set explicitly).
+    whole_frame: bool,
+    tile_fixed: bool,
+    /// Frames rendered, for the progress bar.
+    frames_done: u64,
     /// Shading units per submission, adapted to SUBMISSION_TARGET_S.
     units_per_submission: usize,
     /// Advanced by one per shading unit done, when set (the CLI sets one on a terminal).
@@ -229,6 +245,9 @@ impl Renderer {
             shade,
             lights: scene.lights.clone(),
             tile: DEFAULT_TILE,
+            whole_frame: false,
+            tile_fixed: false,
+            frames_done: 0,
             units_per_submission: 1,
             progress: None,
             debug_view: DebugViewPass::new(&ctx)?,
@@ -249,19 +268,24 @@ impl Renderer {
         })
     }
 
-    /// Shading units (tiles, times point ranges for brute force) in one frame.
-    pub fn shading_units(&self) -> usize {
-        self.units().len()
-    }
-
     fn units(&self) -> Vec<shade::ShadeUnit> {
         let brute_force_points = self.brute_force.then_some(self.hierarchy.point_count);
-        shade::shade_units(self.extent.width, self.extent.height, self.tile, brute_force_points)
+        let (w, h) = (self.extent.width, self.extent.height);
+        let tile = if self.whole_frame { w.max(h) } else { self.tile };
+        shade::shade_units(w, h, tile, brute_force_points)
     }
 
-    /// Shades in tiles of `tile` pixels square from the next frame on (tests compare tilings).
+    /// Shades in tiles of `tile` pixels square from the next frame on, always (tests compare
+    /// tilings).
     pub fn set_tile_size(&mut self, tile: u32) {
         self.tile = tile.max(1);
+        self.tile_fixed = true;
+        self.whole_frame = false;
+    }
+
+    /// The progress bar's length for `frames` frames (it counts thousandths of a frame).
+    pub fn progress_length(frames: u32) -> u64 {
+        frames as u64 * 1000
     }
 
     /// Renders one frame and returns its GPU timestamp scopes (empty without a profiler). The
@@ -307,6 +331,7 @@ impl Renderer {
         // Shading in several submissions, so that none runs long (see SUBMISSION_TARGET_S).
         let units = self.units();
         let mut done = 0;
+        let (mut submissions, mut shading_seconds) = (0, 0.0);
         while done < units.len() {
             let batch = &units[done..(done + self.units_per_submission).min(units.len())];
             let started = std::time::Instant::now();
@@ -320,10 +345,15 @@ impl Renderer {
             })?;
             let seconds = started.elapsed().as_secs_f64();
             done += batch.len();
+            (submissions, shading_seconds) = (submissions + 1, shading_seconds + seconds);
             if let Some(bar) = &self.progress {
-                bar.inc(batch.len() as u64);
+                bar.set_position(self.frames_done * 1000 + (1000 * done / units.len()) as u64);
             }
             self.units_per_submission = next_batch_size(batch.len(), seconds);
+        }
+        self.frames_done += 1;
+        if !self.tile_fixed {
+            self.whole_frame = shade_whole_frame(self.whole_frame, submissions, shading_seconds);
         }
 
         if self.show == Show::Samples {
@@ -411,5 +441,14 @@ mod tests {
         assert_eq!(next_batch_size(8, 0.8), 2, "slow: shrinks to what fits");
         assert_eq!(next_batch_size(1, 30.0), 1, "never below one unit");
         assert_eq!(next_batch_size(4, 0.0), 8);
+    }
+
+    #[test]
+    fn fast_frames_are_shaded_whole() {
+        assert!(shade_whole_frame(false, 1, 0.01), "one quick submission: one tile next time");
+        assert!(!shade_whole_frame(false, 2, 0.01), "several submissions: keep the tiles");
+        assert!(!shade_whole_frame(false, 1, 0.1), "not quick enough to risk a whole frame");
+        assert!(shade_whole_frame(true, 1, 0.15), "stays whole while under the target");
+        assert!(!shade_whole_frame(true, 1, 0.5), "back to tiles when a frame gets slow");
     }
 }
