@@ -65,14 +65,15 @@ fn tree_matches_brute_force_within_one_percent() {
     }
 }
 
-/// A custom material with a short diffusion length (σa = 1, σs' = 2 per mm: 1/σtr = mfp = 1/3 mm),
-/// on a slab 8 × 8 × 2 mm (24 diffusion lengths wide), lit from `light_dir`, seen from straight
-/// above with a narrow field of view; returns the centre pixel's radiance (red channel).
+/// A custom material with short diffusion lengths, different per channel (σa = 1, 0.5, 2 and
+/// σs = 2, 3, 1 per mm: 1/σtr = 0.33, 0.44, 0.24 mm), on a slab 8 × 8 × 2 mm (at least 18
+/// diffusion lengths wide), lit from `light_dir`, seen from straight above with a narrow field of
+/// view; returns the centre pixel's radiance per channel.
 /// `extra` picks the integration: `--brute-force` checks the model, sampling and irradiance alone
 /// (`--no-specular` is added unless `extra` has `--roughness`);
 /// the tree's own error (a node at its power centre underestimates a convex Sd) is measured
 /// against brute force in `tree_matches_brute_force_within_one_percent` and printed here.
-fn slab_centre(model: &str, light_dir: &str, extra: &[&str]) -> f32 {
+fn slab_centre(model: &str, light_dir: &str, extra: &[&str]) -> [f64; 3] {
     let light = format!("dir:{light_dir}:1");
     let args = [
         "--mesh",
@@ -82,9 +83,9 @@ fn slab_centre(model: &str, light_dir: &str, extra: &[&str]) -> f32 {
         "--material",
         "marble",
         "--sigma-a",
-        "1",
+        "1,0.5,2",
         "--sigma-s",
-        "2",
+        "2,3,1",
         "--g",
         "0",
         "--eta",
@@ -117,31 +118,37 @@ fn slab_centre(model: &str, light_dir: &str, extra: &[&str]) -> f32 {
     let img = image::open(&path).unwrap().into_rgba32f();
     let p = img.get_pixel(4, 4);
     assert_eq!(p[3], 1.0);
-    p[0]
+    [p[0] as f64, p[1] as f64, p[2] as f64]
 }
 
-fn slab_medium() -> translucent::physics::Medium {
-    translucent::physics::Medium { sigma_a: 1.0, sigma_s: 2.0, g: 0.0, eta: 1.3 }
+fn slab_medium(channel: usize) -> translucent::physics::Medium {
+    let (sigma_a, sigma_s) = [(1.0, 2.0), (0.5, 3.0), (2.0, 1.0)][channel];
+    translucent::physics::Medium { sigma_a, sigma_s, g: 0.0, eta: 1.3 }
 }
 
 #[test]
 fn thick_slab_classical_dipole_equals_the_closed_form() {
     use translucent::physics::{dipole, fresnel, Diffusion};
-    let c = slab_medium().constants(Diffusion::Classical);
     let ft0 = fresnel::transmittance(1.3, 1.0);
-    let expected = ft0 * ft0 * dipole::total_rd(c.alpha_reduced, c.a_dipole) / std::f64::consts::PI;
-    let got = slab_centre("dipole", "0,1,0", &["--brute-force"]) as f64;
-    let tree = slab_centre("dipole", "0,1,0", &[]) as f64;
-    println!("classical dipole slab: {got:.6} (tree at the default epsilon {tree:.6}) vs E Ft² Rd/π = {expected:.6}");
-    assert!((got - expected).abs() <= 0.02 * expected);
+    let got = slab_centre("dipole", "0,1,0", &["--brute-force"]);
+    let tree = slab_centre("dipole", "0,1,0", &[]);
+    for ch in 0..3 {
+        let c = slab_medium(ch).constants(Diffusion::Classical);
+        let expected = ft0 * ft0 * dipole::total_rd(c.alpha_reduced, c.a_dipole) / std::f64::consts::PI;
+        println!(
+            "classical dipole slab, channel {ch}: {:.6} (tree at the default epsilon {:.6}) vs E Ft² Rd/π = {expected:.6}",
+            got[ch], tree[ch]
+        );
+        assert!((got[ch] - expected).abs() <= 0.02 * expected, "channel {ch}");
+    }
 }
 
 /// ∫Sd dA over the plane y = 0 (normal +y) for light arriving from `toward` at the origin, exit
 /// at the origin: polar grid, log-spaced radii.
-fn dirpole_plane_integral(toward: glam::DVec3) -> f64 {
+fn dirpole_plane_integral(toward: glam::DVec3, channel: usize) -> f64 {
     use glam::DVec3;
     use translucent::physics::{dirpole, Diffusion};
-    let c = slab_medium().constants(Diffusion::Classical);
+    let c = slab_medium(channel).constants(Diffusion::Classical);
     let n = DVec3::Y;
     let (radii, angles) = (4000, 256);
     let (lo, hi) = (1e-6f64.ln(), (40.0 / c.sigma_tr).ln());
@@ -169,13 +176,16 @@ fn thick_slab_directional_dipole_equals_the_plane_integral() {
     for (label, toward) in [("0,1,0", DVec3::Y), ("0.8660254,0.5,0", DVec3::new(0.866_025_4, 0.5, 0.0))] {
         let cos_i = toward.y;
         let irradiance_in = cos_i * fresnel::transmittance(1.3, cos_i);
-        let expected = ft0 * irradiance_in * dirpole_plane_integral(toward.normalize());
-        let got = slab_centre("directional", label, &["--brute-force"]) as f64;
-        let tree = slab_centre("directional", label, &[]) as f64;
-        println!(
-            "directional dipole slab, light {label}: {got:.6} (tree at the default epsilon {tree:.6}) vs {expected:.6}"
-        );
-        assert!((got - expected).abs() <= 0.02 * expected, "{label}: {got} vs {expected}");
+        let got = slab_centre("directional", label, &["--brute-force"]);
+        let tree = slab_centre("directional", label, &[]);
+        for ch in 0..3 {
+            let expected = ft0 * irradiance_in * dirpole_plane_integral(toward.normalize(), ch);
+            println!(
+                "directional dipole slab, light {label}, channel {ch}: {:.6} (tree at the default epsilon {:.6}) vs {expected:.6}",
+                got[ch], tree[ch]
+            );
+            assert!((got[ch] - expected).abs() <= 0.02 * expected, "{label} channel {ch}: {} vs {expected}", got[ch]);
+        }
     }
 }
 
@@ -187,11 +197,13 @@ fn specular_lobe_at_normal_incidence_equals_the_closed_form() {
     let roughness = 0.35f64;
     let alpha2 = roughness.powi(4);
     let expected = fresnel::reflectance(1.3, 1.0) / (4.0 * std::f64::consts::PI * alpha2);
-    let without = slab_centre("dipole", "0,1,0", &[]) as f64;
-    let with = slab_centre("dipole", "0,1,0", &["--roughness", "0.35"]) as f64;
-    let lobe = with - without;
-    println!("specular at normal incidence: {lobe:.6} vs F/(4πα²) = {expected:.6}");
-    assert!((lobe - expected).abs() <= 0.01 * expected, "{lobe} vs {expected}");
+    let without = slab_centre("dipole", "0,1,0", &[]);
+    let with = slab_centre("dipole", "0,1,0", &["--roughness", "0.35"]);
+    for ch in 0..3 {
+        let lobe = with[ch] - without[ch];
+        println!("specular at normal incidence, channel {ch}: {lobe:.6} vs F/(4πα²) = {expected:.6}");
+        assert!((lobe - expected).abs() <= 0.01 * expected, "channel {ch}: {lobe} vs {expected}");
+    }
 }
 
 /// `--profile` reports the work per pixel counted on the GPU: brute force evaluates every point at
