@@ -36,9 +36,12 @@ vec3 source(vec3 xi, vec3 ni, vec3 wi, vec3 power, vec3 xo, vec3 no) {
     vec3 sd;
     // Written out, not looped: loop iterations count against llvmpipe's budget (see main).
     if (params.model == 0u) {
-        sd = vec3(dirpole_sd(params.channels[0], xi * s, ni, wi, xo * s, no),
-                  dirpole_sd(params.channels[1], xi * s, ni, wi, xo * s, no),
-                  dirpole_sd(params.channels[2], xi * s, ni, wi, xo * s, no));
+        // The geometry once for all three channels (they share eta).
+        vec3 xi_mm = xi * s, xo_mm = xo * s;
+        DirpoleGeometry g = dirpole_geometry(xi_mm, ni, wi, xo_mm, no, params.channels[0].eta);
+        sd = vec3(dirpole_channel_sd(params.channels[0], g, xi_mm, xo_mm, no),
+                  dirpole_channel_sd(params.channels[1], g, xi_mm, xo_mm, no),
+                  dirpole_channel_sd(params.channels[2], g, xi_mm, xo_mm, no));
     } else {
         float r = length(xo - xi) * s;
         sd = vec3(dipole_sd(params.channels[0], r), dipole_sd(params.channels[1], r), dipole_sd(params.channels[2], r));

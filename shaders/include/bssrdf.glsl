@@ -70,46 +70,70 @@ vec3 refract_in(vec3 wi, vec3 ni, float eta) {
     return -(wi - cos_i * ni) / eta - ni * sqrt(k);
 }
 
-// Real and virtual source terms; Sd = max(0, real - virtual).
-void dirpole_terms(BssrdfChannel c, vec3 xi, vec3 ni, vec3 wi, vec3 xo, vec3 no,
-                   out float real_term, out float virtual_term) {
+// What the directional dipole needs of a (xi, ni, wi; xo, no) query that does not depend on the
+// channel's coefficients: computed once and shared by the three channels of a source.
+struct DirpoleGeometry {
+    vec3 x;       // xo - xi
+    float r2;
+    vec3 w12;     // refracted light direction
+    float mu0;    // -no . w12
+    vec3 ni_star; // normal of the modified tangent plane
+    vec3 wv;      // virtual source direction
+};
+
+DirpoleGeometry dirpole_geometry(vec3 xi, vec3 ni, vec3 wi, vec3 xo, vec3 no, float eta) {
+    DirpoleGeometry g;
+    g.x = xo - xi;
+    g.r2 = dot(g.x, g.x);
+    g.w12 = refract_in(wi, ni, eta);
+    // Modified tangent plane: the part of ni normal to x; ni where x is zero or parallel to ni.
+    vec3 perp = ni - g.x * (dot(g.x, ni) / max(g.r2, 1e-30));
+    g.ni_star = (g.r2 > 0.0 && dot(perp, perp) > 1e-12) ? normalize(perp) : ni;
+    g.mu0 = -dot(no, g.w12);
+    g.wv = g.w12 - 2.0 * dot(g.w12, g.ni_star) * g.ni_star;
+    return g;
+}
+
+// Real and virtual source terms of one channel; Sd = max(0, real - virtual).
+void dirpole_channel_terms(BssrdfChannel c, DirpoleGeometry g, vec3 xi, vec3 xo, vec3 no,
+                           out float real_term, out float virtual_term) {
     real_term = 0.0;
     virtual_term = 0.0;
     if (c.transports == 0.0) return;
-    vec3 x = xo - xi;
-    float r2 = dot(x, x);
-    vec3 w12 = refract_in(wi, ni, c.eta);
-
-    // Modified tangent plane: the part of ni normal to x; ni where x is zero or parallel to ni.
-    vec3 perp = ni - x * (dot(x, ni) / max(r2, 1e-30));
-    vec3 ni_star = (r2 > 0.0 && dot(perp, perp) > 1e-12) ? normalize(perp) : ni;
-
-    float mu0 = -dot(no, w12);
     float dr2;
-    if (mu0 > 0.0) {
-        float along = dot(x, w12);
-        float cos_beta = -sqrt(max(r2 - along * along, 0.0) / (r2 + c.de * c.de));
-        dr2 = r2 + c.d * mu0 * (c.d * mu0 - 2.0 * c.de * cos_beta);
+    if (g.mu0 > 0.0) {
+        float along = dot(g.x, g.w12);
+        float cos_beta = -sqrt(max(g.r2 - along * along, 0.0) / (g.r2 + c.de * c.de));
+        dr2 = g.r2 + c.d * g.mu0 * (c.d * g.mu0 - 2.0 * c.de * cos_beta);
     } else {
-        dr2 = r2 + c.back_lit_dr2;
+        dr2 = g.r2 + c.back_lit_dr2;
     }
     float dr = sqrt(max(dr2, 1e-24 * c.d * c.d));
 
-    vec3 xv = xi + (2.0 * c.a_dirpole * c.de) * ni_star;
-    vec3 wv = w12 - 2.0 * dot(w12, ni_star) * ni_star;
+    // Virtual source, mirrored in the modified tangent plane.
+    vec3 xv = xi + (2.0 * c.a_dirpole * c.de) * g.ni_star;
     vec3 xov = xo - xv;
     float dv = length(xov);
 
-    real_term = dirpole_source(c, x, w12, dr, no);
-    virtual_term = dirpole_source(c, xov, wv, dv, no);
+    real_term = dirpole_source(c, g.x, g.w12, dr, no);
+    virtual_term = dirpole_source(c, xov, g.wv, dv, no);
 }
 
-float dirpole_sd(BssrdfChannel c, vec3 xi, vec3 ni, vec3 wi, vec3 xo, vec3 no) {
+float dirpole_channel_sd(BssrdfChannel c, DirpoleGeometry g, vec3 xi, vec3 xo, vec3 no) {
     float real_term, virtual_term;
-    dirpole_terms(c, xi, ni, wi, xo, no, real_term, virtual_term);
+    dirpole_channel_terms(c, g, xi, xo, no, real_term, virtual_term);
     float v = real_term - virtual_term;
     // Also maps NaN to 0: a comparison with NaN is false.
     return (v > 0.0 && v < 3.4e38) ? v : 0.0;
+}
+
+void dirpole_terms(BssrdfChannel c, vec3 xi, vec3 ni, vec3 wi, vec3 xo, vec3 no,
+                   out float real_term, out float virtual_term) {
+    dirpole_channel_terms(c, dirpole_geometry(xi, ni, wi, xo, no, c.eta), xi, xo, no, real_term, virtual_term);
+}
+
+float dirpole_sd(BssrdfChannel c, vec3 xi, vec3 ni, vec3 wi, vec3 xo, vec3 no) {
+    return dirpole_channel_sd(c, dirpole_geometry(xi, ni, wi, xo, no, c.eta), xi, xo, no);
 }
 
 #endif
