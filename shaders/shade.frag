@@ -29,7 +29,8 @@ layout(std430, binding = 4) readonly buffer Lights { LightSet light_set; mat4 la
 layout(binding = 5) uniform sampler2DArrayShadow shadow_map;
 
 const uint STACK_SIZE = 96u;
-const uint MAX_VISITS = 16384u;
+// Steps of the walk (nodes and points) before it stops opening nodes: llvmpipe's loop budget.
+const uint MAX_STEPS = 32768u;
 
 vec3 source(vec3 xi, vec3 ni, vec3 wi, vec3 power, vec3 xo, vec3 no) {
     float s = params.mm_per_unit;
@@ -86,34 +87,49 @@ void main() {
         for (uint i = pc.point_range.x; i < end; ++i) sum += point_source(i, xo, no);
         evaluated = end > pc.point_range.x ? end - pc.point_range.x : 0u;
     } else {
+        // Points are pushed like nodes, so that each step evaluates at most one source at one
+        // place in the code: the lanes of a SIMD group (llvmpipe) or warp (GPU) that evaluate in
+        // a step do it together, whether their source is a node or a point.
         uint stack[STACK_SIZE];
         uint top = 0u;
         stack[top++] = 0u;
+        uint steps = 0u;
         while (top > 0u) {
-            TreeNode node = nodes[stack[--top]];
-            ++visits;
-            if (node.power == vec3(0.0)) continue;
-            vec3 lo, hi;
-            unpack_box(node.box_half, lo, hi);
-            vec3 d = node.power_center - xo;
-            bool inside = all(greaterThanEqual(xo, lo)) && all(lessThanEqual(xo, hi));
-            // A full stack or a spent iteration budget (see above) ends the descent: the node is
-            // then used whole, an approximation rather than a silently truncated sum.
-            bool must_stop = top + 2u > STACK_SIZE || visits > MAX_VISITS;
-            if ((!inside && node.area < params.epsilon * dot(d, d)) || must_stop) {
-                sum += source(node.power_center, decode_oct(node.normal_oct), decode_oct(node.light_oct), node.power, xo, no);
-                continue;
-            }
-            uint children[2] = uint[2](node.left, node.right);
-            for (int k = 0; k < 2; ++k) {
-                uint child = children[k];
-                if ((child & LEAF_BIT) != 0u) {
-                    sum += point_source(child & ~LEAF_BIT, xo, no);
-                    ++evaluated;
-                } else {
-                    stack[top++] = child;
+            uint item = stack[--top];
+            ++steps;
+            vec3 xi, ni, wi, power;
+            if ((item & LEAF_BIT) != 0u) {
+                SurfacePoint p = points[item & ~LEAF_BIT];
+                ++evaluated;
+                if (p.irradiance == vec3(0.0)) continue;
+                xi = p.position;
+                ni = p.normal;
+                wi = p.light_dir;
+                power = p.irradiance * p.area;
+            } else {
+                TreeNode node = nodes[item];
+                ++visits;
+                if (node.power == vec3(0.0)) continue;
+                vec3 lo, hi;
+                unpack_box(node.box_half, lo, hi);
+                vec3 d = node.power_center - xo;
+                bool inside = all(greaterThanEqual(xo, lo)) && all(lessThanEqual(xo, hi));
+                // A full stack or a spent step budget (see above) ends the descent: the node is
+                // then used whole, an approximation rather than a silently truncated sum.
+                bool must_stop = top + 2u > STACK_SIZE || steps > MAX_STEPS;
+                if (inside || node.area >= params.epsilon * dot(d, d)) {
+                    if (!must_stop) {
+                        stack[top++] = node.left;
+                        stack[top++] = node.right;
+                        continue;
+                    }
                 }
+                xi = node.power_center;
+                ni = decode_oct(node.normal_oct);
+                wi = decode_oct(node.light_oct);
+                power = node.power;
             }
+            sum += source(xi, ni, wi, power, xo, no);
         }
     }
     // Helper invocations' atomics have no effect (Vulkan spec), so only real pixels count.
