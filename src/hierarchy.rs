@@ -198,7 +198,8 @@ impl Hierarchy {
             irradiance: IrradiancePass::new(ctx)?,
             sort: SortPass::new(ctx)?,
             tree: TreePass::new(ctx)?,
-            prefix: storage("triangle area prefix sum", (mesh.triangle_count() as u64 + 1) * 4)?,
+            // The total area (f32 and padding), then N + 1 64-bit fixed-point sums.
+            prefix: storage("triangle area prefix sum", 8 + (mesh.triangle_count() as u64 + 1) * 8)?,
             points: storage("points", n64 * 64)?,
             keys: [storage("morton keys A", n64 * 8)?, storage("morton keys B", n64 * 8)?],
             values: [storage("sort order A", n64 * 4)?, storage("sort order B", n64 * 4)?],

@@ -272,3 +272,71 @@ fn irradiance_of_two_lights_is_the_sum_of_each() {
     }
     assert!(lit_by_b > 100, "the point light must light part of the torus");
 }
+
+/// Two triangles making the unit square in the xz plane.
+fn unit_square() -> Mesh {
+    let positions = vec![Vec3::ZERO, Vec3::X, Vec3::new(1.0, 0.0, 1.0), Vec3::Z];
+    Mesh { positions, normals: vec![Vec3::Y; 4], indices: vec![0, 2, 1, 0, 3, 2] }
+}
+
+/// Variance over mean of the point counts in `cells` × `cells` squares of the unit square: 1 for
+/// independent uniform points (Poisson), below for stratified ones, far above for clumps.
+fn cell_count_dispersion(points: &[SurfacePoint], cells: usize) -> (f64, u32, u32) {
+    let mut counts = vec![0u32; cells * cells];
+    for p in points {
+        let (x, z) = (p.position.x.clamp(0.0, 0.999_999), p.position.z.clamp(0.0, 0.999_999));
+        counts[(z * cells as f32) as usize * cells + (x * cells as f32) as usize] += 1;
+    }
+    let mean = points.len() as f64 / counts.len() as f64;
+    let variance = counts.iter().map(|&c| (c as f64 - mean).powi(2)).sum::<f64>() / counts.len() as f64;
+    (variance / mean, *counts.iter().min().unwrap(), *counts.iter().max().unwrap())
+}
+
+/// At the sizes a user may ask for, the barycentrics must not fall onto a lattice: an R2
+/// sequence computed as `fract(float(i) · α)` in f32 has only a few distinct values past a
+/// million points (at i = 1.6M the product's spacing is 1/8), so points clump.
+#[test]
+fn samples_stay_uniform_at_one_and_a_half_million_points() {
+    let n = 1_500_000u32;
+    let s = build(&unit_square(), &[sun(Vec3::Y, 1.0)], n);
+    let cells = 300;
+    let (dispersion, min, max) = cell_count_dispersion(&s.points, cells);
+    println!(
+        "{n} points in {cells}² cells, {:.1} per cell: variance/mean {dispersion:.4}, min {min}, max {max}",
+        n as f64 / (cells * cells) as f64
+    );
+    // Independent uniform points give 1; stratified low-discrepancy points far less.
+    assert!(dispersion < 0.25, "points clump (variance/mean of cell counts {dispersion})");
+}
+
+/// The points that fall in any run of consecutive triangles are, by the stratification along the
+/// area prefix sum, N × (their area / total area) within ±1 — for a mesh of two million triangles
+/// too, where an f32 running sum of areas has lost the small triangles' areas to rounding.
+#[test]
+fn stratification_holds_over_two_million_triangles() {
+    let mesh = irregular_grid(1000);
+    let n = 1_000_003u32;
+    let s = build(&mesh, &[sun(Vec3::Y, 1.0)], n);
+    let areas = mesh.triangle_areas();
+    let total: f64 = areas.iter().map(|&a| a as f64).sum();
+    let mut counts = vec![0u32; areas.len()];
+    for p in &s.points {
+        counts[p.triangle as usize] += 1;
+    }
+    let group = 2000;
+    let mut worst = 0.0f64;
+    let (mut cumulative_area, mut cumulative_count) = (0.0f64, 0u64);
+    for (g, (a, c)) in areas.chunks(group).zip(counts.chunks(group)).enumerate() {
+        cumulative_area += a.iter().map(|&x| x as f64).sum::<f64>();
+        cumulative_count += c.iter().map(|&x| x as u64).sum::<u64>();
+        // Points before the end of group g: stratum i covers [i, i + 1) · total / N.
+        let expected = n as f64 * cumulative_area / total;
+        let off = cumulative_count as f64 - expected;
+        if off.abs() > worst {
+            worst = off.abs();
+            println!("group {g}: {cumulative_count} points before its end, expected {expected:.2}");
+        }
+    }
+    println!("{} triangles, {n} points: worst cumulative count off by {worst:.2} points", areas.len());
+    assert!(worst <= 1.5, "the stratification drifts by {worst:.2} points");
+}

@@ -1,4 +1,4 @@
-//! Surface sampling: the triangle-area prefix sum, then N points uniform by area.
+//! Surface sampling: the triangle-area prefix sum (64-bit fixed point), then N points uniform by area.
 //! Reads: vertices, indices. Writes: area prefix sum, points (unsorted).
 
 use bytemuck::{Pod, Zeroable};
@@ -23,7 +23,7 @@ impl SamplingPass {
     pub fn new(ctx: &Context) -> Result<SamplingPass> {
         use BindingKind::StorageBuffer as S;
         Ok(SamplingPass {
-            areas: Pipeline::compute(ctx, "hierarchy/triangle_areas.comp", &[S, S, S], 4)?,
+            areas: Pipeline::compute(ctx, "hierarchy/triangle_areas.comp", &[S, S, S], 8)?,
             points: Pipeline::compute(ctx, "hierarchy/sample_points.comp", &[S, S, S, S], 12)?,
         })
     }
@@ -43,7 +43,7 @@ impl SamplingPass {
         rec.dispatch(
             &self.areas,
             &[Bind::Read(vertices), Bind::Read(indices), Bind::Write(prefix)],
-            &triangle_count.to_le_bytes(),
+            bytemuck::bytes_of(&[triangle_count, point_count]),
             [1, 1, 1],
         )?;
         let constants = SampleConstants { point_count, triangle_count, seed };
