@@ -1,9 +1,12 @@
 #version 460
 // Subsurface scattering per pixel: walks the Jensen–Buhler tree from the root with an explicit
-// stack; a node far and small enough (area / distance² < epsilon, and xo outside its box) is one
-// source at its power centre, otherwise its children are visited; points are evaluated singly.
-// Lo(xo, wo) = Ft(eta, wo) · Σ Sd(xi, wi; xo, no) · power_i, power = E·A (mm²), plus the surface's
-// own reflection from each light: a microfacet lobe, shadowed by the same shadow maps.
+// stack; a node far and small enough (area / distance² from its area centre < epsilon, and xo
+// outside its box) is used whole: one source per light at that light's power centre; otherwise
+// its children are visited; points are evaluated singly, one source per light.
+// Lo(xo, wo) = Ft(eta, wo) · Σ over sources and lights Sd(xi, wi_k; xo, no) · power_k, power = E·A
+// (mm²), plus the surface's own reflection from each light: a microfacet lobe, shadowed by the
+// same shadow maps. Which nodes are used whole does not depend on the lights, and each term
+// depends on one light only, so renders of several lights are the sums of each alone.
 #include "common.glsl"
 #include "shade_constants.glsl"
 #include "points.glsl"
@@ -27,9 +30,12 @@ layout(std430, binding = 2) readonly buffer Sorted { SurfacePoint points[]; };
 layout(std430, binding = 3) buffer WorkCounters { uint pixels; uint node_sum; uint node_max; uint point_sum; uint point_max; } work;
 layout(std430, binding = 4) readonly buffer Lights { LightSet light_set; mat4 layer_matrices[]; };
 layout(binding = 5) uniform sampler2DArrayShadow shadow_map;
+layout(std430, binding = 6) readonly buffer SortedPointLights { PointLight point_lights[]; };
+layout(std430, binding = 7) readonly buffer NodeLights { NodeLight node_lights[]; };
 
 const uint STACK_SIZE = 96u;
-// Steps of the walk (nodes and points) before it stops opening nodes: llvmpipe's loop budget.
+// Loop iterations of the walk (steps over nodes and points, and the lights of each source) before
+// it stops opening nodes: llvmpipe's loop budget.
 const uint MAX_STEPS = 32768u;
 
 vec3 source(vec3 xi, vec3 ni, vec3 wi, vec3 power, vec3 xo, vec3 no) {
@@ -50,10 +56,12 @@ vec3 source(vec3 xi, vec3 ni, vec3 wi, vec3 power, vec3 xo, vec3 no) {
     return sd * power * (s * s); // power is irradiance × scene-unit area: to mm²
 }
 
-vec3 point_source(uint i, vec3 xo, vec3 no) {
-    SurfacePoint p = points[i];
-    if (p.irradiance == vec3(0.0)) return vec3(0.0);
-    return source(p.position, p.normal, p.light_dir, p.irradiance * p.area, xo, no);
+// One light's record of one point: record = point · light_count + light.
+vec3 point_light_source(uint record, vec3 xo, vec3 no) {
+    PointLight l = point_lights[record];
+    if (l.irradiance == vec3(0.0)) return vec3(0.0);
+    SurfacePoint p = points[record / light_set.light_count];
+    return source(p.position, p.normal, decode_oct(l.toward_oct), l.irradiance * p.area, xo, no);
 }
 
 // Σ over lights of f_spec(wi, wo) · E · cos θi · visibility.
@@ -80,11 +88,13 @@ void main() {
     vec3 sum = vec3(0.0);
     uint visits = 0u;
     uint evaluated = 0u;
+    uint light_count = light_set.light_count;
     if (params.brute_force != 0u || params.node_count == 0u) {
-        // One draw per range of points, added by blending: llvmpipe (lavapipe) silently ends a
-        // shader invocation's loops after ~65k iterations in total, so no draw may loop longer.
-        uint end = min(pc.point_range.x + pc.point_range.y, params.point_count);
-        for (uint i = pc.point_range.x; i < end; ++i) sum += point_source(i, xo, no);
+        // One draw per range of (point, light) records, added by blending: llvmpipe (lavapipe)
+        // silently ends a shader invocation's loops after ~65k iterations in total, so no draw
+        // may loop longer.
+        uint end = min(pc.point_range.x + pc.point_range.y, params.point_count * light_count);
+        for (uint r = pc.point_range.x; r < end; ++r) sum += point_light_source(r, xo, no);
         evaluated = end > pc.point_range.x ? end - pc.point_range.x : 0u;
     } else {
         // Points are pushed like nodes, so that each step evaluates at most one source at one
@@ -97,22 +107,23 @@ void main() {
         while (top > 0u) {
             uint item = stack[--top];
             ++steps;
-            vec3 xi, ni, wi, power;
-            if ((item & LEAF_BIT) != 0u) {
-                SurfacePoint p = points[item & ~LEAF_BIT];
+            // The source's lights are records [first, first + light_count) of one of the arrays.
+            bool is_point = (item & LEAF_BIT) != 0u;
+            uint first;
+            vec3 ni;
+            if (is_point) {
+                uint i = item & ~LEAF_BIT;
                 ++evaluated;
-                if (p.irradiance == vec3(0.0)) continue;
-                xi = p.position;
-                ni = p.normal;
-                wi = p.light_dir;
-                power = p.irradiance * p.area;
+                if (points[i].irradiance == vec3(0.0)) continue;
+                first = i * light_count;
+                ni = points[i].normal;
             } else {
                 TreeNode node = nodes[item];
                 ++visits;
                 if (node.power == vec3(0.0)) continue;
                 vec3 lo, hi;
                 unpack_box(node.box_half, lo, hi);
-                vec3 d = node.power_center - xo;
+                vec3 d = node.center - xo;
                 bool inside = all(greaterThanEqual(xo, lo)) && all(lessThanEqual(xo, hi));
                 // A full stack or a spent step budget (see above) ends the descent: the node is
                 // then used whole, an approximation rather than a silently truncated sum.
@@ -124,12 +135,28 @@ void main() {
                         continue;
                     }
                 }
-                xi = node.power_center;
+                first = item * light_count;
                 ni = decode_oct(node.normal_oct);
-                wi = decode_oct(node.light_oct);
-                power = node.power;
             }
-            sum += source(xi, ni, wi, power, xo, no);
+            // One evaluation site for points and nodes alike (see above), once per light.
+            for (uint k = 0u; k < light_count; ++k) {
+                vec3 xi, power;
+                uint toward_oct;
+                if (is_point) {
+                    PointLight l = point_lights[first + k];
+                    xi = points[item & ~LEAF_BIT].position;
+                    power = l.irradiance * points[item & ~LEAF_BIT].area;
+                    toward_oct = l.toward_oct;
+                } else {
+                    NodeLight l = node_lights[first + k];
+                    xi = l.power_center;
+                    power = l.power;
+                    toward_oct = l.toward_oct;
+                }
+                if (power == vec3(0.0)) continue;
+                sum += source(xi, ni, decode_oct(toward_oct), power, xo, no);
+            }
+            steps += light_count;
         }
     }
     // Helper invocations' atomics have no effect (Vulkan spec), so only real pixels count.
@@ -142,7 +169,7 @@ void main() {
             atomicMax(work.node_max, visits);
             // A brute-force pixel's points span several draws: its maximum is all of them (the
             // measured sum over the draws checks it).
-            atomicMax(work.point_max, brute_force ? params.point_count : evaluated);
+            atomicMax(work.point_max, brute_force ? params.point_count * light_count : evaluated);
         }
         atomicAdd(work.point_sum, evaluated);
     }

@@ -61,7 +61,7 @@ fn run_one(
     specular: bool,
 ) -> Result<Run> {
     let ctx = Context::new(context)?;
-    hierarchy::check_point_count(&ctx, n)?;
+    hierarchy::check_point_count(&ctx, n, scene.lights.len() as u32)?;
     let device = format!("{} ({})", ctx.info.name, ctx.info.driver);
     let options = FrameOptions {
         subsurface: SubsurfaceOptions {
@@ -165,7 +165,7 @@ pub fn run(options: &BenchOptions) -> Result<String> {
                 " | {:.1} | {:.1} | {:.1} | {:.0} |\n",
                 per_pixel(&run.work, run.work.node_sum),
                 per_pixel(&run.work, run.work.point_sum),
-                hierarchy::bytes_used(n) as f64 / (1 << 20) as f64,
+                hierarchy::bytes_used(n, 1) as f64 / (1 << 20) as f64,
                 peak_rss_mib().unwrap_or(f64::NAN)
             );
             eprintln!("bench: {} N={n} done", mesh_name(spec));

@@ -563,7 +563,7 @@ fn render(args: &RenderArgs) -> Result<i32> {
     let eta = material.eta as f32;
     let point_count = match args.samples {
         Some(n) => {
-            crate::hierarchy::check_point_count(&ctx, n)?;
+            crate::hierarchy::check_point_count(&ctx, n, scene.lights.len() as u32)?;
             n
         }
         None => default_point_count(&ctx, &scene, &material),
@@ -652,7 +652,7 @@ fn default_point_count(ctx: &Context, scene: &Scene, material: &Material) -> u32
         .filter(|c| c.transports && c.sigma_tr > 0.0)
         .map(|c| (1.0 / c.sigma_tr).min(1.0 / c.sigma_t_reduced))
         .fold(f64::INFINITY, f64::min) as f32;
-    let budget = crate::hierarchy::max_points(ctx).min(1 << 18);
+    let budget = crate::hierarchy::max_points(ctx, scene.lights.len() as u32).min(1 << 18);
     let (n, spacing) = crate::hierarchy::choose_point_count(area_mm2, shortest, budget);
     eprintln!(
         "samples: {n} points, {spacing:.3} mm apart on {area_mm2:.0} mm² (shortest of mean free path and diffusion length: {shortest:.3} mm)"

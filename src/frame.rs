@@ -269,7 +269,8 @@ impl Renderer {
     }
 
     fn units(&self) -> Vec<shade::ShadeUnit> {
-        let brute_force_points = self.brute_force.then_some(self.hierarchy.point_count);
+        // Brute force sums (point, light) records, in ranges.
+        let brute_force_points = self.brute_force.then_some(self.hierarchy.point_count * self.hierarchy.light_count);
         let (w, h) = (self.extent.width, self.extent.height);
         let tile = if self.whole_frame { w.max(h) } else { self.tile };
         shade::shade_units(w, h, tile, brute_force_points)
@@ -312,6 +313,8 @@ impl Renderer {
             lights: &self.hierarchy.lights,
             shadow_map: &self.hierarchy.shadow_map,
             shadow_sampler: &self.hierarchy.shadow_sampler,
+            point_lights: &self.hierarchy.sorted_point_lights,
+            node_lights: &self.hierarchy.node_lights,
         };
 
         // The frame, in order: the hierarchy (sampling, shadow maps, irradiance, Morton codes,

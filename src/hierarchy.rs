@@ -37,6 +37,24 @@ pub struct SurfacePoint {
     pub pad1: f32,
 }
 
+/// Mirrors `PointLight` in shaders/include/points.glsl (16 bytes): one light at one point.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct PointLight {
+    pub irradiance: Vec3,
+    pub toward_oct: u32,
+}
+
+/// Mirrors `NodeLight` in shaders/include/points.glsl (32 bytes): one light over one node.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct NodeLight {
+    pub power: Vec3,
+    pub toward_oct: u32,
+    pub power_center: Vec3,
+    pub spread2: f32,
+}
+
 /// Set in a child index when the child is a point (index into the sorted points).
 pub const LEAF_BIT: u32 = 0x8000_0000;
 
@@ -46,7 +64,7 @@ pub const LEAF_BIT: u32 = 0x8000_0000;
 pub struct TreeNode {
     pub power: Vec3,
     pub area: f32,
-    pub power_center: Vec3,
+    pub center: Vec3,
     pub left: u32,
     pub box_half: [u32; 3],
     pub right: u32,
@@ -104,35 +122,41 @@ pub fn decode_oct(e: u32) -> Vec3 {
 }
 
 /// Bytes on the GPU per sample point: the point twice (unsorted, sorted), two keys, two values,
-/// a point parent and about one node (with its parent and arrival counter).
+/// a point parent and about one node (with its parent and arrival counter); and per light, the
+/// point's record twice (unsorted, sorted) and about one node's.
 const BYTES_PER_POINT: u64 = 64 * 2 + 8 * 2 + 4 * 2 + 4 + 64 + 4 + 4 + 4;
+const BYTES_PER_POINT_AND_LIGHT: u64 = 16 * 2 + 32;
 
-/// The largest sample count the device can hold: each buffer within `maxStorageBufferRange`.
-pub fn max_points(ctx: &Context) -> u32 {
+/// The largest per-point-and-light buffer's element (the nodes' light records).
+const NODE_LIGHT_BYTES: u64 = std::mem::size_of::<NodeLight>() as u64;
+
+/// The largest sample count the device can hold with `lights` lights: each buffer within
+/// `maxStorageBufferRange`.
+pub fn max_points(ctx: &Context, lights: u32) -> u32 {
     let range = ctx.limits().max_storage_buffer_range as u64;
-    // The largest per-point buffers (points, nodes) are 64 bytes per element; the radix count
-    // table is 256 counters per tile of 256 keys, about 4 bytes per key.
-    (range / 64).min(u32::MAX as u64 / 2) as u32
+    // The largest per-point buffers are the points and nodes (64 bytes per element) and the
+    // nodes' light records (32 bytes per light); the radix count table is about 4 bytes per key.
+    (range / 64).min(range / (NODE_LIGHT_BYTES * lights.max(1) as u64)).min(u32::MAX as u64 / 2) as u32
 }
 
-/// Checks a requested sample count against the device.
-pub fn check_point_count(ctx: &Context, n: u32) -> Result<()> {
-    let max = max_points(ctx);
+/// Checks a requested sample count against the device, for `lights` lights.
+pub fn check_point_count(ctx: &Context, n: u32, lights: u32) -> Result<()> {
+    let max = max_points(ctx, lights);
     if n < 2 {
         return Err(bad_input!("--samples {n}: at least 2 sample points are needed"));
     }
     if n > max {
         return Err(bad_input!(
-            "--samples {n}: more than this device can hold ({max}: {} MiB per storage buffer, 64 bytes per point and node)",
+            "--samples {n}: more than this device can hold with {lights} light(s) ({max}: {} MiB per storage buffer, 64 bytes per point and node, 32 per node and light)",
             ctx.limits().max_storage_buffer_range >> 20
         ));
     }
     Ok(())
 }
 
-/// Memory the hierarchy uses on the GPU for `n` points, in bytes.
-pub fn bytes_used(n: u32) -> u64 {
-    n as u64 * BYTES_PER_POINT
+/// Memory the hierarchy uses on the GPU for `n` points and `lights` lights, in bytes.
+pub fn bytes_used(n: u32, lights: u32) -> u64 {
+    n as u64 * (BYTES_PER_POINT + lights as u64 * BYTES_PER_POINT_AND_LIGHT)
 }
 
 pub struct Hierarchy {
@@ -148,6 +172,11 @@ pub struct Hierarchy {
     counts: Buffer,
     pub sorted_points: Buffer,
     pub nodes: Buffer,
+    /// Each light's record of each point, [point · light_count + light], unsorted then sorted.
+    point_lights: Buffer,
+    pub sorted_point_lights: Buffer,
+    /// Each light's record of each node, [node · light_count + light].
+    pub node_lights: Buffer,
     pub node_parent: Buffer,
     pub point_parent: Buffer,
     pub arrivals: Buffer,
@@ -158,6 +187,8 @@ pub struct Hierarchy {
     eta: f32,
     shadow_resolution: u32,
     pub point_count: u32,
+    /// Lights the per-light records were made for (at creation; later light sets may not exceed it).
+    pub light_count: u32,
     triangle_count: u32,
     index_count: u32,
     bounds: (Vec3, Vec3),
@@ -173,10 +204,11 @@ pub struct HierarchyOptions {
 impl Hierarchy {
     pub fn new(ctx: &Context, mesh: &Mesh, lights: &[Light], options: &HierarchyOptions) -> Result<Hierarchy> {
         let n = options.point_count;
-        check_point_count(ctx, n)?;
         if lights.is_empty() || lights.len() > MAX_LIGHTS {
             return Err(bad_input!("between 1 and {MAX_LIGHTS} lights are supported, {} given", lights.len()));
         }
+        let light_count = lights.len() as u32;
+        check_point_count(ctx, n, light_count)?;
         let storage = |name: &str, bytes: u64| {
             Buffer::new(
                 ctx,
@@ -206,6 +238,9 @@ impl Hierarchy {
             counts: storage("radix counts", tiles * 256 * 4)?,
             sorted_points: storage("sorted points", n64 * 64)?,
             nodes: storage("tree nodes", (n64 - 1) * 64)?,
+            point_lights: storage("point light records", n64 * light_count as u64 * 16)?,
+            sorted_point_lights: storage("sorted point light records", n64 * light_count as u64 * 16)?,
+            node_lights: storage("node light records", (n64 - 1) * light_count as u64 * NODE_LIGHT_BYTES)?,
             node_parent: storage("node parents", (n64 - 1) * 4)?,
             point_parent: storage("point parents", n64 * 4)?,
             arrivals: storage("node arrival counters", (n64 - 1) * 4)?,
@@ -229,6 +264,7 @@ impl Hierarchy {
             eta: options.eta,
             shadow_resolution: res,
             point_count: n,
+            light_count,
             triangle_count: mesh.triangle_count() as u32,
             index_count: mesh.indices.len() as u32,
             bounds: (lo - Vec3::splat(pad), hi + Vec3::splat(pad)),
@@ -244,6 +280,9 @@ impl Hierarchy {
         let (eta, resolution) = (self.eta, self.shadow_resolution);
         if lights.is_empty() || lights.len() > MAX_LIGHTS {
             return Err(bad_input!("between 1 and {MAX_LIGHTS} lights are supported, {} given", lights.len()));
+        }
+        if lights.len() != self.light_count as usize {
+            return Err(runtime!("{} lights given, the hierarchy was made for {}", lights.len(), self.light_count));
         }
         let (centre, radius) = crate::scene::bounding_sphere(&mesh.positions);
         let radius = radius.max(1e-6) * 1.01;
@@ -295,7 +334,15 @@ impl Hierarchy {
         rec.end_scope();
 
         rec.begin_scope("irradiance");
-        self.irradiance.record(rec, &self.points, n, &self.lights, &self.shadow_map, &self.shadow_sampler)?;
+        self.irradiance.record(
+            rec,
+            &self.points,
+            &self.point_lights,
+            n,
+            &self.lights,
+            &self.shadow_map,
+            &self.shadow_sampler,
+        )?;
         rec.end_scope();
 
         let sort_buffers = SortBuffers {
@@ -304,6 +351,9 @@ impl Hierarchy {
             values: [&self.values[0], &self.values[1]],
             counts: &self.counts,
             sorted_points: &self.sorted_points,
+            point_lights: &self.point_lights,
+            sorted_point_lights: &self.sorted_point_lights,
+            light_count: self.light_count,
         };
         rec.begin_scope("morton codes");
         self.sort.record_morton(rec, &sort_buffers, n, self.bounds)?;
@@ -319,6 +369,9 @@ impl Hierarchy {
             node_parent: &self.node_parent,
             point_parent: &self.point_parent,
             arrivals: &self.arrivals,
+            sorted_point_lights: &self.sorted_point_lights,
+            node_lights: &self.node_lights,
+            light_count: self.light_count,
         };
         rec.begin_scope("tree build");
         self.tree.record_build(rec, &tree_buffers, n)?;
@@ -338,6 +391,8 @@ impl Hierarchy {
             order: vk::download_buffer(ctx, &self.values[0], n)?,
             sorted_points: vk::download_buffer(ctx, &self.sorted_points, n)?,
             nodes: vk::download_buffer(ctx, &self.nodes, n - 1)?,
+            sorted_point_lights: vk::download_buffer(ctx, &self.sorted_point_lights, n * self.light_count as usize)?,
+            node_lights: vk::download_buffer(ctx, &self.node_lights, (n - 1) * self.light_count as usize)?,
         })
     }
 
@@ -352,6 +407,10 @@ pub struct Snapshot {
     pub order: Vec<u32>,
     pub sorted_points: Vec<SurfacePoint>,
     pub nodes: Vec<TreeNode>,
+    /// [point · light_count + light], sorted order.
+    pub sorted_point_lights: Vec<PointLight>,
+    /// [node · light_count + light].
+    pub node_lights: Vec<NodeLight>,
 }
 
 /// A node built on the CPU in f64, for checking the GPU's.
@@ -363,7 +422,8 @@ pub struct ReferenceNode {
     pub point_count: u32,
     pub power: DVec3,
     pub area: f64,
-    pub power_center: DVec3,
+    /// Area-weighted mean position.
+    pub center: DVec3,
     pub normal: DVec3,
     /// |Σ child normal × area| / Σ area: near 0 where the normals cancel (the direction is noise).
     pub normal_coherence: f64,
@@ -428,7 +488,7 @@ pub fn reference_tree(keys: &[[u32; 2]], points: &[SurfacePoint]) -> Vec<Referen
                 point_count: (last - first + 1) as u32,
                 power: DVec3::ZERO,
                 area: 0.0,
-                power_center: DVec3::ZERO,
+                center: DVec3::ZERO,
                 normal: DVec3::ZERO,
                 normal_coherence: 0.0,
                 light_dir: DVec3::ZERO,
@@ -462,8 +522,7 @@ pub fn reference_tree(keys: &[[u32; 2]], points: &[SurfacePoint]) -> Vec<Referen
         let b = summarise(r, nodes, points);
         let lum = |c: DVec3| c.dot(DVec3::new(0.2126, 0.7152, 0.0722));
         let (wa, wb) = (lum(a.0), lum(b.0));
-        let centre =
-            if wa + wb > 0.0 { (a.2 * wa + b.2 * wb) / (wa + wb) } else { (a.2 * a.1 + b.2 * b.1) / (a.1 + b.1) };
+        let centre = (a.2 * a.1 + b.2 * b.1) / (a.1 + b.1);
         let normal = (a.3 * a.1 + b.3 * b.1).normalize_or(DVec3::Z);
         let light = (a.4 * wa + b.4 * wb).normalize_or_zero();
         let node = &mut nodes[k as usize];
@@ -471,7 +530,7 @@ pub fn reference_tree(keys: &[[u32; 2]], points: &[SurfacePoint]) -> Vec<Referen
         node.light_coherence = if wa + wb > 0.0 { (a.4 * wa + b.4 * wb).length() / (wa + wb) } else { 0.0 };
         node.power = a.0 + b.0;
         node.area = a.1 + b.1;
-        node.power_center = centre;
+        node.center = centre;
         node.normal = normal;
         node.light_dir = light;
         node.lo = a.5.min(b.5);

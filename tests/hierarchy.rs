@@ -94,10 +94,10 @@ fn check_tree(s: &Snapshot) {
         for c in 0..3 {
             let extent = (r.hi - r.lo).max_element().max(1e-9);
             assert!(
-                ((g.power_center[c] as f64) - r.power_center[c]).abs() <= 1e-4 * extent.max(1.0),
+                ((g.center[c] as f64) - r.center[c]).abs() <= 1e-4 * extent.max(1.0),
                 "node {k} centre {} vs {} (power {} vs {})",
-                g.power_center,
-                r.power_center,
+                g.center,
+                r.center,
                 g.power,
                 r.power
             );
@@ -125,6 +125,22 @@ fn check_tree(s: &Snapshot) {
         }
     }
     assert!(worst <= 1e-4, "power/area differ from the CPU build by {worst:e}");
+    // Each light's records: they add up to the node's power, and the root's is that light's sum
+    // over the points.
+    let lights = s.node_lights.len() / s.nodes.len();
+    for (k, node) in s.nodes.iter().enumerate() {
+        let sum: Vec3 = s.node_lights[k * lights..(k + 1) * lights].iter().map(|l| l.power).sum();
+        assert!((sum - node.power).abs().max_element() <= 1e-4 * node.power.max_element().max(1e-30), "node {k}");
+    }
+    for light in 0..lights {
+        let total: f64 = s
+            .sorted_points
+            .iter()
+            .enumerate()
+            .map(|(i, p)| (s.sorted_point_lights[i * lights + light].irradiance.x * p.area) as f64)
+            .sum();
+        assert!(rel(s.node_lights[light].power.x as f64, total) < 1e-4, "root power of light {light}");
+    }
     assert!(in_leaf.iter().all(|&c| c == 1), "every point must sit in exactly one leaf (of one point)");
     let total: f64 = s.sorted_points.iter().map(|p| (p.irradiance.x * p.area) as f64).sum();
     assert!(rel(s.nodes[0].power.x as f64, total) < 1e-4, "root power {} vs sum {total}", s.nodes[0].power.x);
@@ -271,6 +287,17 @@ fn irradiance_of_two_lights_is_the_sum_of_each() {
         lit_by_b += (pb.irradiance.x > 0.0) as u32;
     }
     assert!(lit_by_b > 100, "the point light must light part of the torus");
+    // Each light's records are those of that light alone: the same points and tree, and
+    // summaries that depend on one light only.
+    for (k, single) in [&only_a, &only_b].into_iter().enumerate() {
+        for (i, record) in single.sorted_point_lights.iter().enumerate() {
+            assert_eq!(both.sorted_point_lights[2 * i + k].irradiance, record.irradiance, "point {i}, light {k}");
+        }
+        for (n, record) in single.node_lights.iter().enumerate() {
+            let mine = both.node_lights[2 * n + k];
+            assert_eq!((mine.power, mine.power_center), (record.power, record.power_center), "node {n}, light {k}");
+        }
+    }
 }
 
 /// Two triangles making the unit square in the xz plane.

@@ -43,7 +43,7 @@ fn subsurface_params_and_tree_match_glsl() {
     let rust: Vec<u32> = [
         offset_of!(TreeNode, power),
         offset_of!(TreeNode, area),
-        offset_of!(TreeNode, power_center),
+        offset_of!(TreeNode, center),
         offset_of!(TreeNode, left),
         offset_of!(TreeNode, box_half),
         offset_of!(TreeNode, right),
@@ -73,6 +73,23 @@ fn subsurface_params_and_tree_match_glsl() {
     .collect();
     assert_eq!(point, rust);
     assert_eq!(size_of::<SurfacePoint>(), 64);
+}
+
+#[test]
+fn light_records_match_glsl() {
+    use translucent::hierarchy::{NodeLight, PointLight};
+    let point = member_offsets("shade.frag", "PointLight").expect("PointLight");
+    assert_eq!(point, [offset_of!(PointLight, irradiance), offset_of!(PointLight, toward_oct)].map(|o| o as u32));
+    assert_eq!(size_of::<PointLight>(), 16);
+    let node = member_offsets("shade.frag", "NodeLight").expect("NodeLight");
+    let rust = [
+        offset_of!(NodeLight, power),
+        offset_of!(NodeLight, toward_oct),
+        offset_of!(NodeLight, power_center),
+        offset_of!(NodeLight, spread2),
+    ];
+    assert_eq!(node, rust.map(|o| o as u32));
+    assert_eq!(size_of::<NodeLight>(), 32);
 }
 
 #[test]

@@ -444,3 +444,74 @@ fn brute_force_converges_as_samples_grow() {
         assert!(worst[2] <= 0.005, "{model}: {} at 500k points", worst[2]);
     }
 }
+
+/// Relative RMSE of `sum` against `reference`, where `sum` is the pixel-wise sum of `parts`.
+fn sum_of(parts: &[Vec<[f32; 4]>]) -> Vec<[f32; 4]> {
+    let mut sum = parts[0].clone();
+    for part in &parts[1..] {
+        for (s, p) in sum.iter_mut().zip(part) {
+            for c in 0..3 {
+                s[c] += p[c];
+            }
+        }
+    }
+    sum
+}
+
+/// Lights add: under the directional dipole, which is not linear in the light's direction, a
+/// render of several lights equals the sum of each alone, with the tree and with brute force,
+/// because every light is its own source (the walk's choice of nodes does not depend on them).
+/// One irradiance with a mean direction made a directional and a point light differ from their
+/// sum by 3.3%.
+#[test]
+fn lights_add_exactly_under_both_models() {
+    let fixed = ["--mesh", "sphere"];
+    let (a, b) = ("dir:-0.3,0.7,-0.6:2", "point:1.5,1,1.5:4,3,2");
+    for model in ["directional", "dipole"] {
+        for method in [&[][..], &["--brute-force"][..]] {
+            let render_with = |name: &str, lights: &[&str]| {
+                let mut args: Vec<&str> = fixed.to_vec();
+                args.extend_from_slice(&["--model", model]);
+                args.extend_from_slice(method);
+                for l in lights {
+                    args.extend_from_slice(&["--light", l]);
+                }
+                render(&format!("lights-{model}-{}-{name}", method.len()), &args)
+            };
+            let both = render_with("both", &[a, b]);
+            let parts = [render_with("a", &[a]), render_with("b", &[b])];
+            let error = relative_rmse(&both, &sum_of(&parts));
+            println!("{model} {method:?}: two lights against the sum of each alone: relative RMSE {error:.2e}");
+            assert!(error <= 1e-3, "{model} {method:?}: {error}");
+        }
+    }
+}
+
+/// Eight lights of both kinds, the tree and the directional dipole: still the sum of each alone.
+#[test]
+fn eight_lights_add_exactly() {
+    let lights = [
+        "dir:-0.3,0.7,-0.6:1",
+        "dir:0.8,0.2,0.3:0.5,0.7,1",
+        "dir:0,-1,0.2:0.3",
+        "dir:0.1,0.3,1:1,0.5,0.2",
+        "point:1.5,1,1.5:2",
+        "point:-1.6,0.4,0.9:1,2,3",
+        "point:0.2,-1.7,-1:3",
+        "point:0,1.8,0:0.5",
+    ];
+    let fixed = ["--mesh", "sphere"];
+    let mut all: Vec<&str> = fixed.to_vec();
+    for l in &lights {
+        all.extend_from_slice(&["--light", l]);
+    }
+    let together = render("eight-lights", &all);
+    let parts: Vec<Vec<[f32; 4]>> = lights
+        .iter()
+        .enumerate()
+        .map(|(k, l)| render(&format!("eight-lights-{k}"), &[&fixed[..], &["--light", l]].concat()))
+        .collect();
+    let error = relative_rmse(&together, &sum_of(&parts));
+    println!("eight lights against the sum of each alone: relative RMSE {error:.2e}");
+    assert!(error <= 1e-3, "{error}");
+}

@@ -11,24 +11,43 @@ struct SurfacePoint {
     uint triangle;     // the triangle it was sampled on
     vec3 irradiance;   // W/m² per RGB entering the surface: I cos Ft(eta) visibility, summed over lights
     float pad0;
-    vec3 light_dir;    // irradiance-weighted mean direction toward the lights (unit, or 0 if unlit)
+    vec3 light_dir;    // irradiance-weighted mean direction toward the lights (unit, or 0 if unlit;
+                       // for views and tools: shading uses each light's own PointLight)
     float pad1;
+};
+
+// What one light brings to one point (16 bytes), at [point · light_count + light]. Each light is
+// its own source: the directional dipole is not linear in the light's direction, so lights
+// summed into one irradiance with a mean direction would not add up.
+struct PointLight {
+    vec3 irradiance;   // entering the surface from this light (0 where it does not reach)
+    uint toward_oct;   // unit direction toward this light, octahedral 2×16-bit snorm
 };
 
 // A node of the Karras (HPG 2012) binary radix tree over the Morton-sorted points (64 bytes).
 // Children with LEAF_BIT set are point indices (in sorted order), else node indices.
 const uint LEAF_BIT = 0x80000000u;
 struct TreeNode {
-    vec3 power;        // sum of irradiance × area per RGB
+    vec3 power;        // sum of irradiance × area per RGB, over all lights
     float area;        // sum of point areas
-    vec3 power_center;     // power-weighted mean position (area-weighted where the power is 0)
+    vec3 center;       // area-weighted mean position: where the walk measures the distance from,
+                       // the same whatever the lights, so that lights add exactly
     uint left;
     uvec3 box_half;    // bounding box as 6 halfs, rounded outward: min.xy | min.z max.x | max.yz
     uint right;
     uint normal_oct;   // area-weighted mean normal, octahedral 2×16-bit snorm
-    uint light_oct;    // power-weighted mean light direction, octahedral 2×16-bit snorm
+    uint light_oct;    // power-weighted mean light direction, octahedral 2×16-bit snorm (for views)
     uint first_point;  // the node's points are sorted points [first_point, first_point + point_count)
     uint point_count;
+};
+
+// What one light brings to one node (32 bytes), at [node · light_count + light]: the node used
+// whole is one source per light, at that light's power centre.
+struct NodeLight {
+    vec3 power;        // sum of this light's irradiance × area per RGB
+    uint toward_oct;   // power-weighted mean direction toward the light, octahedral
+    vec3 power_center; // power-weighted mean position (area-weighted where the power is 0)
+    float spread2;     // power-weighted mean squared distance of the points from power_center
 };
 
 // Octahedral encoding of a unit vector (Cigolle et al. 2014) into 2×16-bit snorm.

@@ -1,5 +1,6 @@
 //! Irradiance at each point from every light, with shadow-map visibility and Fresnel transmittance.
-//! Reads: lights, shadow map. Writes: points (irradiance, light direction).
+//! Reads: lights, shadow map. Writes: points (irradiance, mean light direction), each light's
+//! record of each point.
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec4;
@@ -41,16 +42,18 @@ impl IrradiancePass {
             pipeline: Pipeline::compute(
                 ctx,
                 "hierarchy/irradiance.comp",
-                &[StorageBuffer, StorageBuffer, SampledImage],
+                &[StorageBuffer, StorageBuffer, SampledImage, StorageBuffer],
                 4,
             )?,
         })
     }
 
+    #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
         rec: &mut Recorder,
         points: &Buffer,
+        point_lights: &Buffer,
         point_count: u32,
         lights: &Buffer,
         shadow_map: &Image,
@@ -58,7 +61,7 @@ impl IrradiancePass {
     ) -> Result<()> {
         rec.dispatch(
             &self.pipeline,
-            &[Bind::Write(points), Bind::Read(lights), Bind::Sampled(shadow_map, sampler)],
+            &[Bind::Write(points), Bind::Read(lights), Bind::Sampled(shadow_map, sampler), Bind::Write(point_lights)],
             &point_count.to_le_bytes(),
             [point_count.div_ceil(64), 1, 1],
         )

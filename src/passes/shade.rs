@@ -1,6 +1,6 @@
 //! The shade pass: rasterises the mesh and, per fragment, integrates the BSSRDF over the tree
 //! (shaders/shade.frag), plus the surface's microfacet reflection. Reads: vertices, indices,
-//! parameters, tree nodes, sorted points, lights and shadow maps. Writes: colour and depth
+//! parameters, tree nodes, sorted points, their light records, lights and shadow maps. Writes: colour and depth
 //! targets, work counters.
 
 use bytemuck::{Pod, Zeroable};
@@ -25,8 +25,8 @@ pub struct ShadeConstants {
     pub point_range: glam::UVec4,
 }
 
-/// Points per brute-force draw: keeps every fragment invocation's loop short (llvmpipe ends loops
-/// after ~65k iterations; a real GPU's watchdog dislikes long draws too).
+/// (Point, light) records per brute-force draw: keeps every fragment invocation's loop short
+/// (llvmpipe ends loops after ~65k iterations; a real GPU's watchdog dislikes long draws too).
 pub const POINTS_PER_DRAW: u32 = 8192;
 
 /// Mirrors `SubsurfaceParams` in shaders/include/subsurface_params.glsl.
@@ -73,6 +73,8 @@ pub struct ShadeInputs<'a> {
     pub lights: &'a Buffer,
     pub shadow_map: &'a Image,
     pub shadow_sampler: &'a Sampler,
+    pub point_lights: &'a Buffer,
+    pub node_lights: &'a Buffer,
 }
 
 /// One piece of a frame's shading: a rectangle of pixels and, for brute force, a range of points.
@@ -142,6 +144,8 @@ impl ShadePass {
                         StorageBuffer,
                         StorageBuffer,
                         SampledImage,
+                        StorageBuffer,
+                        StorageBuffer,
                     ],
                     push_constant_size: std::mem::size_of::<ShadeConstants>() as u32,
                 },
@@ -200,6 +204,8 @@ impl ShadePass {
             Bind::Write(inputs.work),
             Bind::Read(inputs.lights),
             Bind::Sampled(inputs.shadow_map, inputs.shadow_sampler),
+            Bind::Read(inputs.point_lights),
+            Bind::Read(inputs.node_lights),
         ];
         let mut c = *constants;
         c.point_range = glam::UVec4::new(unit.first_point, unit.point_count, 0, 0);

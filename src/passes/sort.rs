@@ -1,5 +1,6 @@
 //! Morton codes and a stable GPU radix sort of (key, point index), then the points gathered in
-//! Morton order. Reads: points. Writes: keys, order, sorted points.
+//! Morton order with their light records. Reads: points, point light records. Writes: keys,
+//! order, sorted points and light records.
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec3, Vec4};
@@ -33,6 +34,9 @@ pub struct SortBuffers<'a> {
     pub values: [&'a Buffer; 2],
     pub counts: &'a Buffer,
     pub sorted_points: &'a Buffer,
+    pub point_lights: &'a Buffer,
+    pub sorted_point_lights: &'a Buffer,
+    pub light_count: u32,
 }
 
 pub struct SortPass {
@@ -51,7 +55,7 @@ impl SortPass {
             histogram: Pipeline::compute(ctx, "hierarchy/radix_histogram.comp", &[S, S], 12)?,
             scan: Pipeline::compute(ctx, "hierarchy/radix_scan.comp", &[S], 12)?,
             scatter: Pipeline::compute(ctx, "hierarchy/radix_scatter.comp", &[S, S, S, S, S], 12)?,
-            gather: Pipeline::compute(ctx, "hierarchy/gather_points.comp", &[S, S, S], 4)?,
+            gather: Pipeline::compute(ctx, "hierarchy/gather_points.comp", &[S, S, S, S, S], 8)?,
         })
     }
 
@@ -97,8 +101,14 @@ impl SortPass {
         }
         rec.dispatch(
             &self.gather,
-            &[Bind::Read(b.points), Bind::Read(b.values[0]), Bind::Write(b.sorted_points)],
-            &n.to_le_bytes(),
+            &[
+                Bind::Read(b.points),
+                Bind::Read(b.values[0]),
+                Bind::Write(b.sorted_points),
+                Bind::Read(b.point_lights),
+                Bind::Write(b.sorted_point_lights),
+            ],
+            bytemuck::bytes_of(&[n, b.light_count]),
             [n.div_ceil(64), 1, 1],
         )
     }

@@ -1,5 +1,6 @@
 //! The Karras binary radix tree over the sorted keys, then its bottom-up summaries.
-//! Reads: sorted keys, sorted points. Writes: nodes, parent links, arrival counters.
+//! Reads: sorted keys, sorted points and their light records. Writes: nodes and their light
+//! records, parent links, arrival counters.
 
 use crate::error::Result;
 use crate::vk::{Bind, BindingKind, Buffer, Context, Pipeline, Recorder};
@@ -11,6 +12,9 @@ pub struct TreeBuffers<'a> {
     pub node_parent: &'a Buffer,
     pub point_parent: &'a Buffer,
     pub arrivals: &'a Buffer,
+    pub sorted_point_lights: &'a Buffer,
+    pub node_lights: &'a Buffer,
+    pub light_count: u32,
 }
 
 pub struct TreePass {
@@ -23,7 +27,7 @@ impl TreePass {
         use BindingKind::StorageBuffer as S;
         Ok(TreePass {
             build: Pipeline::compute(ctx, "hierarchy/tree_build.comp", &[S, S, S, S, S], 4)?,
-            aggregate: Pipeline::compute(ctx, "hierarchy/tree_aggregate.comp", &[S, S, S, S, S], 4)?,
+            aggregate: Pipeline::compute(ctx, "hierarchy/tree_aggregate.comp", &[S, S, S, S, S, S, S], 8)?,
         })
     }
 
@@ -51,8 +55,10 @@ impl TreePass {
                 Bind::Read(b.node_parent),
                 Bind::Read(b.point_parent),
                 Bind::Write(b.arrivals),
+                Bind::Read(b.sorted_point_lights),
+                Bind::Write(b.node_lights),
             ],
-            &n.to_le_bytes(),
+            bytemuck::bytes_of(&[n, b.light_count]),
             [n.div_ceil(64), 1, 1],
         )
     }
