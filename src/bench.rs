@@ -9,7 +9,7 @@
 use glam::Vec3;
 
 use crate::error::Result;
-use crate::frame::{FrameOptions, Renderer, Show, SubsurfaceOptions};
+use crate::frame::{FrameOptions, Renderer, Show, SubsurfaceOptions, DEFAULT_EPSILON};
 use crate::hierarchy::{self, HierarchyOptions};
 use crate::mesh::Mesh;
 use crate::output::{Exposure, HdrImage};
@@ -137,7 +137,7 @@ pub fn run(options: &BenchOptions) -> Result<String> {
         let scene = scene(spec)?;
         for &n in &options.samples {
             let size = (options.width, options.height);
-            let run = match run_one(&options.context, &scene, n, size, options.frames, 0.1, false, true) {
+            let run = match run_one(&options.context, &scene, n, size, options.frames, DEFAULT_EPSILON, false, true) {
                 Ok(r) => r,
                 Err(e) => {
                     out += &format!("| {} | {n} | — {e} |\n", mesh_name(spec));
@@ -146,7 +146,7 @@ pub fn run(options: &BenchOptions) -> Result<String> {
             };
             if !header_done {
                 out += &format!(
-                    "### Every pass\n\nDevice: {}; {}x{}, back-lit marble, directional dipole, ε = 0.1; mean of {} frame(s) after one warm-up frame. Peak RSS is the process's high-water mark so far (on lavapipe GPU memory is host memory).\n\n",
+                    "### Every pass\n\nDevice: {}; {}x{}, back-lit marble, directional dipole, ε = {DEFAULT_EPSILON}; mean of {} frame(s) after one warm-up frame. Peak RSS is the process's high-water mark so far (on lavapipe GPU memory is host memory).\n\n",
                     run.device,
                     options.width,
                     options.height,
@@ -180,15 +180,15 @@ pub fn run(options: &BenchOptions) -> Result<String> {
     let scene = scene(spec)?;
     let size = (options.accuracy_size, options.accuracy_size);
     out += &format!(
-        "\n### Hierarchy against brute force\n\n{} at {s}x{s}, subsurface term only, ε = 0.1; shade pass time (mean of {} frame(s) after a warm-up), relative RMSE over covered pixels.\n\n| points | brute force ms | hierarchy ms | speed-up | BSSRDF evaluations/px (brute / tree) | nodes visited/px | relative RMSE |\n|---:|---:|---:|---:|---:|---:|---:|\n",
+        "\n### Hierarchy against brute force\n\n{} at {s}x{s}, subsurface term only, ε = {DEFAULT_EPSILON}; shade pass time (mean of {} frame(s) after a warm-up), relative RMSE over covered pixels.\n\n| points | brute force ms | hierarchy ms | speed-up | BSSRDF evaluations/px (brute / tree) | nodes visited/px | relative RMSE |\n|---:|---:|---:|---:|---:|---:|---:|\n",
         mesh_name(spec),
         options.frames.max(2) - 1,
         s = options.accuracy_size
     );
     let mut sweep_reference = None;
     for &n in &options.accuracy_samples {
-        let brute = run_one(&options.context, &scene, n, size, options.frames, 0.1, true, false)?;
-        let tree = run_one(&options.context, &scene, n, size, options.frames, 0.1, false, false)?;
+        let brute = run_one(&options.context, &scene, n, size, options.frames, DEFAULT_EPSILON, true, false)?;
+        let tree = run_one(&options.context, &scene, n, size, options.frames, DEFAULT_EPSILON, false, false)?;
         let (b, t) = (pass_ms(&brute, "shade"), pass_ms(&tree, "shade"));
         // A node used whole is one evaluation, like a point.
         let tree_evaluations = per_pixel(&tree.work, tree.work.point_sum + tree.work.node_sum);
