@@ -27,7 +27,8 @@ layout(std430, binding = 0) readonly buffer Params { SubsurfaceParams params; };
 layout(std430, binding = 1) readonly buffer Nodes { TreeNode nodes[]; };
 layout(std430, binding = 2) readonly buffer Sorted { SurfacePoint points[]; };
 // Work per pixel for --profile: sums and maxima of nodes visited and points evaluated.
-layout(std430, binding = 3) buffer WorkCounters { uint pixels; uint node_sum; uint node_max; uint point_sum; uint point_max; } work;
+// Sd evaluations: calls of source(), each for three channels (a node used whole is two per light).
+layout(std430, binding = 3) buffer WorkCounters { uint pixels; uint node_sum; uint node_max; uint point_sum; uint point_max; uint evaluation_sum; } work;
 layout(std430, binding = 4) readonly buffer Lights { LightSet light_set; mat4 layer_matrices[]; };
 layout(binding = 5) uniform sampler2DArrayShadow shadow_map;
 layout(std430, binding = 6) readonly buffer SortedPointLights { PointLight point_lights[]; };
@@ -88,6 +89,7 @@ void main() {
     vec3 sum = vec3(0.0);
     uint visits = 0u;
     uint evaluated = 0u;
+    uint evaluations = 0u;
     uint light_count = light_set.light_count;
     if (params.brute_force != 0u || params.node_count == 0u) {
         // One draw per range of (point, light) records, added by blending: llvmpipe (lavapipe)
@@ -96,6 +98,7 @@ void main() {
         uint end = min(pc.point_range.x + pc.point_range.y, params.point_count * light_count);
         for (uint r = pc.point_range.x; r < end; ++r) sum += point_light_source(r, xo, no);
         evaluated = end > pc.point_range.x ? end - pc.point_range.x : 0u;
+        evaluations = evaluated;
     } else {
         // Points are pushed like nodes, so that each step evaluates at most one source at one
         // place in the code: the lanes of a SIMD group (llvmpipe) or warp (GPU) that evaluate in
@@ -166,6 +169,7 @@ void main() {
                     toward_oct = l.toward_oct;
                 }
                 if (power == vec3(0.0)) continue;
+                ++evaluations;
                 sum += source(xi, ni, decode_oct(toward_oct), power, xo, no);
             }
             steps += light_count * per_light;
@@ -184,6 +188,7 @@ void main() {
             atomicMax(work.point_max, brute_force ? params.point_count * light_count : evaluated);
         }
         atomicAdd(work.point_sum, evaluated);
+        atomicAdd(work.evaluation_sum, evaluations);
     }
     float cos_o = max(dot(no, wo), 0.0);
     vec3 lo = fresnel_transmittance(params.channels[0].eta, cos_o) * sum;

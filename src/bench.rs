@@ -190,12 +190,11 @@ pub fn run(options: &BenchOptions) -> Result<String> {
         let brute = run_one(&options.context, &scene, n, size, options.frames, DEFAULT_EPSILON, true, false)?;
         let tree = run_one(&options.context, &scene, n, size, options.frames, DEFAULT_EPSILON, false, false)?;
         let (b, t) = (pass_ms(&brute, "shade"), pass_ms(&tree, "shade"));
-        // A node used whole is one evaluation, like a point.
-        let tree_evaluations = per_pixel(&tree.work, tree.work.point_sum + tree.work.node_sum);
+        let tree_evaluations = per_pixel(&tree.work, tree.work.evaluation_sum);
         out += &format!(
             "| {n} | {b:.1} | {t:.1} | {:.1}× | {:.0} / {:.0} | {:.1} | {:.3}% |\n",
             b / t,
-            per_pixel(&brute.work, brute.work.point_sum),
+            per_pixel(&brute.work, brute.work.evaluation_sum),
             tree_evaluations,
             per_pixel(&tree.work, tree.work.node_sum),
             100.0 * relative_rmse(&tree.image, &brute.image)
@@ -207,7 +206,7 @@ pub fn run(options: &BenchOptions) -> Result<String> {
     }
     if let Some((n, brute)) = sweep_reference {
         out += &format!(
-            "\n### Epsilon sweep\n\n{} at {s}x{s}, {n} points, subsurface term only; brute force shades in {:.1} ms.\n\n| ε | shade ms | nodes visited/px | points evaluated/px | relative RMSE |\n|---:|---:|---:|---:|---:|\n",
+            "\n### Epsilon sweep\n\n{} at {s}x{s}, {n} points, subsurface term only; brute force shades in {:.1} ms.\n\n| ε | shade ms | nodes visited/px | points evaluated/px | Sd evaluations/px | relative RMSE |\n|---:|---:|---:|---:|---:|---:|\n",
             mesh_name(spec),
             pass_ms(&brute, "shade"),
             s = options.accuracy_size
@@ -215,14 +214,52 @@ pub fn run(options: &BenchOptions) -> Result<String> {
         for &eps in &options.epsilons {
             let tree = run_one(&options.context, &scene, n, size, options.frames, eps, false, false)?;
             out += &format!(
-                "| {eps} | {:.1} | {:.1} | {:.1} | {:.3}% |\n",
+                "| {eps} | {:.1} | {:.1} | {:.1} | {:.1} | {:.3}% |\n",
                 pass_ms(&tree, "shade"),
                 per_pixel(&tree.work, tree.work.node_sum),
                 per_pixel(&tree.work, tree.work.point_sum),
+                per_pixel(&tree.work, tree.work.evaluation_sum),
                 100.0 * relative_rmse(&tree.image, &brute.image)
             );
             eprintln!("bench: epsilon {eps} done");
         }
+        // 4. Cost against the number of lights: each light is its own source.
+        out += &format!(
+            "\n### Lights\n\n{} at {s}x{s}, {n} points, ε = {DEFAULT_EPSILON}, subsurface term only; lights alternate directional and point, all reaching most of the mesh.\n\n| lights | shade ms | per light ms | Sd evaluations/px |\n|---:|---:|---:|---:|\n",
+            mesh_name(spec),
+            s = options.accuracy_size
+        );
+        for count in [1usize, 2, 4, 8] {
+            let mut lit = scene.clone();
+            lit.lights = bench_lights(&scene, count);
+            let run = run_one(&options.context, &lit, n, size, options.frames, DEFAULT_EPSILON, false, false)?;
+            let shade = pass_ms(&run, "shade");
+            out += &format!(
+                "| {count} | {shade:.1} | {:.1} | {:.1} |\n",
+                shade / count as f64,
+                per_pixel(&run.work, run.work.evaluation_sum)
+            );
+            eprintln!("bench: {count} light(s) done");
+        }
     }
     Ok(out)
+}
+
+/// `count` lights around the mesh: the default back light first, then point and directional
+/// lights in turn, spread in azimuth, above the equator.
+fn bench_lights(scene: &Scene, count: usize) -> Vec<Light> {
+    let (centre, radius) = bounding_sphere(&scene.mesh.positions);
+    (0..count)
+        .map(|k| {
+            let angle = k as f32 * std::f32::consts::TAU / count as f32;
+            let toward =
+                Vec3::new(-0.3 * angle.cos() - 0.65 * angle.sin(), 0.7, -0.65 * angle.cos() + 0.3 * angle.sin());
+            if k % 2 == 0 {
+                Light::Directional { toward, irradiance: Vec3::ONE / count as f32 }
+            } else {
+                let position = centre + toward.normalize() * radius * 3.0;
+                Light::Point { position, intensity: Vec3::splat(9.0 * radius * radius / count as f32) }
+            }
+        })
+        .collect()
 }

@@ -631,12 +631,13 @@ fn render(args: &RenderArgs) -> Result<i32> {
     if args.profile && work.pixels > 0 {
         let per_pixel = |sum: u32| sum as f64 / work.pixels as f64;
         println!(
-            "work per pixel (last frame, {} pixels): nodes visited mean {:.1} max {}, points evaluated mean {:.1} max {}",
+            "work per pixel (last frame, {} pixels): nodes visited mean {:.1} max {}, points evaluated mean {:.1} max {}, Sd evaluations mean {:.1}",
             work.pixels,
             per_pixel(work.node_sum),
             work.node_max,
             per_pixel(work.point_sum),
-            work.point_max
+            work.point_max,
+            per_pixel(work.evaluation_sum)
         );
     }
     Ok(validation_exit_code(validating, &counts))

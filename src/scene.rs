@@ -114,6 +114,7 @@ pub fn bounding_sphere(positions: &[Vec3]) -> (Vec3, f32) {
     (centre, radius)
 }
 
+#[derive(Clone)]
 pub struct Scene {
     pub mesh: Mesh,
     pub camera: Camera,

@@ -57,6 +57,8 @@ pub struct WorkCounters {
     pub node_max: u32,
     pub point_sum: u32,
     pub point_max: u32,
+    /// Sd evaluations (three channels each): a point is one per light, a node used whole two.
+    pub evaluation_sum: u32,
 }
 
 /// Everything a shading draw reads, and the targets it writes.
