@@ -35,8 +35,12 @@ layout(std430, binding = 6) readonly buffer SortedPointLights { PointLight point
 layout(std430, binding = 7) readonly buffer NodeLights { NodeLight node_lights[]; };
 
 const uint STACK_SIZE = 96u;
-// Loop iterations of the walk (steps over nodes and points, and the lights of each source) before
-// it stops opening nodes: llvmpipe's loop budget.
+// Stack entries: a point or node index (below 2^24, with LEAF_BIT for points) and the number of
+// its next evaluation plus one (2 · MAX_LIGHTS at most).
+const uint EVALUATION_SHIFT = 24u;
+const uint EVALUATION_MASK = 0x1fu;
+// Steps of the walk (tests of nodes and points, and evaluations) before it stops opening nodes:
+// llvmpipe's loop budget.
 const uint MAX_STEPS = 32768u;
 
 vec3 source(vec3 xi, vec3 ni, vec3 wi, vec3 power, vec3 xo, vec3 no) {
@@ -103,76 +107,82 @@ void main() {
         // Points are pushed like nodes, so that each step evaluates at most one source at one
         // place in the code: the lanes of a SIMD group (llvmpipe) or warp (GPU) that evaluate in
         // a step do it together, whether their source is a node or a point.
+        // Stack entries are a point or node and, in bits 24-28, which of its evaluations is
+        // next: 0 for a fresh entry (test it first), e + 1 for evaluation e. A source's
+        // evaluations (one per light for a point, two sigma points per light for a node) are
+        // steps of this one loop, each pushing the next: lanes of a SIMD group or warp step
+        // together, so those that evaluate do it at the same place, whatever their source.
         uint stack[STACK_SIZE];
         uint top = 0u;
         stack[top++] = 0u;
         uint steps = 0u;
         while (top > 0u) {
-            uint item = stack[--top];
+            uint entry = stack[--top];
             ++steps;
-            // The source's lights are records [first, first + light_count) of one of the arrays.
+            uint next = (entry >> EVALUATION_SHIFT) & EVALUATION_MASK;
+            uint item = entry & ~(EVALUATION_MASK << EVALUATION_SHIFT);
             bool is_point = (item & LEAF_BIT) != 0u;
-            uint first;
+            uint index = item & ~LEAF_BIT;
             vec3 ni;
             if (is_point) {
-                uint i = item & ~LEAF_BIT;
-                ++evaluated;
-                if (points[i].irradiance == vec3(0.0)) continue;
-                first = i * light_count;
-                ni = points[i].normal;
+                ni = points[index].normal;
+                if (next == 0u) {
+                    ++evaluated;
+                    if (points[index].irradiance == vec3(0.0)) continue;
+                }
             } else {
-                TreeNode node = nodes[item];
-                ++visits;
-                if (node.power == vec3(0.0)) continue;
-                vec3 lo, hi;
-                unpack_box(node.box_half, lo, hi);
-                vec3 d = node.center - xo;
-                bool inside = all(greaterThanEqual(xo, lo)) && all(lessThanEqual(xo, hi));
-                // A full stack or a spent step budget (see above) ends the descent: the node is
-                // then used whole, an approximation rather than a silently truncated sum.
-                bool must_stop = top + 2u > STACK_SIZE || steps > MAX_STEPS;
-                if (inside || node.area >= params.epsilon * dot(d, d)) {
-                    if (!must_stop) {
-                        stack[top++] = node.left;
-                        stack[top++] = node.right;
-                        continue;
+                TreeNode node = nodes[index];
+                ni = decode_oct(node.normal_oct);
+                if (next == 0u) {
+                    ++visits;
+                    if (node.power == vec3(0.0)) continue;
+                    vec3 lo, hi;
+                    unpack_box(node.box_half, lo, hi);
+                    vec3 d = node.center - xo;
+                    bool inside = all(greaterThanEqual(xo, lo)) && all(lessThanEqual(xo, hi));
+                    // A full stack or a spent step budget (see above) ends the descent: the node
+                    // is then used whole, an approximation rather than a silently truncated sum.
+                    bool must_stop = top + 2u > STACK_SIZE || steps > MAX_STEPS;
+                    if (inside || node.area >= params.epsilon * dot(d, d)) {
+                        if (!must_stop) {
+                            stack[top++] = node.left;
+                            stack[top++] = node.right;
+                            continue;
+                        }
                     }
                 }
-                first = item * light_count;
-                ni = decode_oct(node.normal_oct);
             }
-            // One evaluation site for points and nodes alike (see above): once per light for a
-            // point, twice per light for a node (its two sigma points, below).
+            uint evaluation = next == 0u ? 0u : next - 1u;
             uint per_light = is_point ? 1u : 2u;
-            for (uint e = 0u; e < light_count * per_light; ++e) {
-                uint k = e / per_light;
-                vec3 xi, power;
-                uint toward_oct;
-                if (is_point) {
-                    PointLight l = point_lights[first + k];
-                    xi = points[item & ~LEAF_BIT].position;
-                    power = l.irradiance * points[item & ~LEAF_BIT].area;
-                    toward_oct = l.toward_oct;
-                } else {
-                    // A node used whole is not one source at its power centre c: Sd is convex
-                    // in distance, so that underestimates it (1-1.5% on a slab). Two sigma
-                    // points c ± s(u + t), s² = spread²/2 per axis of the node's tangent plane
-                    // (u toward xo, t across), match the points' mean and second moments, so
-                    // Sd's curvature along u and t is taken into account to second order.
-                    NodeLight l = node_lights[first + k];
-                    vec3 towards_xo = xo - l.power_center;
-                    vec3 u = towards_xo - ni * dot(towards_xo, ni);
-                    u = dot(u, u) > 0.0 ? normalize(u) : normalize(cross(ni, abs(ni.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0)));
-                    vec3 offset = sqrt(0.5 * l.spread2) * (u + cross(ni, u));
-                    xi = l.power_center + ((e % 2u) == 0u ? offset : -offset);
-                    power = 0.5 * l.power;
-                    toward_oct = l.toward_oct;
-                }
-                if (power == vec3(0.0)) continue;
-                ++evaluations;
-                sum += source(xi, ni, decode_oct(toward_oct), power, xo, no);
+            // The rest of this source's evaluations, after this one (it took this entry's place).
+            if (evaluation + 1u < per_light * light_count) stack[top++] = item | ((evaluation + 2u) << EVALUATION_SHIFT);
+            uint k = evaluation / per_light;
+            vec3 center, power, offset = vec3(0.0);
+            uint toward_oct;
+            if (is_point) {
+                PointLight l = point_lights[index * light_count + k];
+                center = points[index].position;
+                power = l.irradiance * points[index].area;
+                toward_oct = l.toward_oct;
+            } else {
+                // A node used whole is not one source at its power centre c: Sd is convex in
+                // distance, so that underestimates it (1-1.5% on a slab). Two sigma points
+                // c ± s(u + t), s² = spread²/2 per axis of the node's tangent plane (u toward xo,
+                // t across), match the points' mean and second moments, so Sd's curvature along
+                // u and t is taken into account to second order.
+                NodeLight l = node_lights[index * light_count + k];
+                center = l.power_center;
+                power = 0.5 * l.power;
+                toward_oct = l.toward_oct;
+                vec3 towards_xo = xo - center;
+                vec3 u = towards_xo - ni * dot(towards_xo, ni);
+                u = dot(u, u) > 0.0 ? normalize(u) : normalize(cross(ni, abs(ni.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0)));
+                offset = sqrt(0.5 * l.spread2) * (u + cross(ni, u));
+                if ((evaluation & 1u) != 0u) offset = -offset;
             }
-            steps += light_count * per_light;
+            if (power == vec3(0.0)) continue;
+            ++evaluations;
+            sum += source(center + offset, ni, decode_oct(toward_oct), power, xo, no);
         }
     }
     // Helper invocations' atomics have no effect (Vulkan spec), so only real pixels count.

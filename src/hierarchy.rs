@@ -136,7 +136,8 @@ pub fn max_points(ctx: &Context, lights: u32) -> u32 {
     let range = ctx.limits().max_storage_buffer_range as u64;
     // The largest per-point buffers are the points and nodes (64 bytes per element) and the
     // nodes' light records (32 bytes per light); the radix count table is about 4 bytes per key.
-    (range / 64).min(range / (NODE_LIGHT_BYTES * lights.max(1) as u64)).min(u32::MAX as u64 / 2) as u32
+    // The walk's stack entries hold a point or node index in 24 bits (shaders/shade.frag).
+    (range / 64).min(range / (NODE_LIGHT_BYTES * lights.max(1) as u64)).min(1 << 24) as u32
 }
 
 /// Checks a requested sample count against the device, for `lights` lights.
