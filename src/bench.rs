@@ -128,6 +128,19 @@ fn mesh_name(spec: &str) -> &str {
 }
 
 pub fn run(options: &BenchOptions) -> Result<String> {
+    // Everything the user typed is checked before the first (long) configuration runs.
+    {
+        let ctx = Context::new(&options.context)?;
+        for &n in options.samples.iter().chain(&options.accuracy_samples) {
+            hierarchy::check_point_count(&ctx, n)?;
+        }
+        if let Some(e) = options.epsilons.iter().find(|e| !(e.is_finite() && **e >= 0.0)) {
+            return Err(crate::bad_input!("--epsilons: {e} must be a finite number ≥ 0"));
+        }
+        for spec in &options.meshes {
+            Mesh::from_spec(spec)?;
+        }
+    }
     let mut out = String::new();
     let per_pixel = |w: &WorkCounters, sum: u32| if w.pixels > 0 { sum as f64 / w.pixels as f64 } else { 0.0 };
 
@@ -137,13 +150,9 @@ pub fn run(options: &BenchOptions) -> Result<String> {
         let scene = scene(spec)?;
         for &n in &options.samples {
             let size = (options.width, options.height);
-            let run = match run_one(&options.context, &scene, n, size, options.frames, 0.1, false, true) {
-                Ok(r) => r,
-                Err(e) => {
-                    out += &format!("| {} | {n} | — {e} |\n", mesh_name(spec));
-                    continue;
-                }
-            };
+            // An error (a bad --device, too many --samples for the device) ends the command with
+            // its exit code, rather than becoming a row of the table.
+            let run = run_one(&options.context, &scene, n, size, options.frames, 0.1, false, true)?;
             if !header_done {
                 out += &format!(
                     "### Every pass\n\nDevice: {}; {}x{}, back-lit marble, directional dipole, ε = 0.1; mean of {} frame(s) after one warm-up frame. Peak RSS is the process's high-water mark so far (on lavapipe GPU memory is host memory).\n\n",
@@ -168,7 +177,7 @@ pub fn run(options: &BenchOptions) -> Result<String> {
                 hierarchy::bytes_used(n) as f64 / (1 << 20) as f64,
                 peak_rss_mib().unwrap_or(f64::NAN)
             );
-            eprintln!("bench: {} N={n} done", mesh_name(spec));
+            crate::note!("bench: {} N={n} done", mesh_name(spec));
         }
     }
     if options.accuracy_size == 0 {
@@ -200,7 +209,7 @@ pub fn run(options: &BenchOptions) -> Result<String> {
             per_pixel(&tree.work, tree.work.node_sum),
             100.0 * relative_rmse(&tree.image, &brute.image)
         );
-        eprintln!("bench: brute force N={n} done");
+        crate::note!("bench: brute force N={n} done");
         if sweep_reference.is_none() {
             sweep_reference = Some((n, brute));
         }
@@ -221,7 +230,7 @@ pub fn run(options: &BenchOptions) -> Result<String> {
                 per_pixel(&tree.work, tree.work.point_sum),
                 100.0 * relative_rmse(&tree.image, &brute.image)
             );
-            eprintln!("bench: epsilon {eps} done");
+            crate::note!("bench: epsilon {eps} done");
         }
     }
     Ok(out)

@@ -397,6 +397,7 @@ impl Renderer {
             rec.end_scope();
             Ok(())
         })?;
+        self.check_finite()?;
         Ok(self.profiler.as_mut().map(|p| p.take_scopes()).unwrap_or_default())
     }
 
@@ -416,9 +417,36 @@ impl Renderer {
         let ext = path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).unwrap_or_default();
         if ext == "png" {
             let image = self.tone_mapped_image()?;
-            return image.save(path).map_err(|e| crate::runtime!("cannot write {}: {e}", path.display()));
+            return output::write_file(path, &output::encode(image, image::ImageFormat::Png)?);
         }
         output::write_image(path, &self.image()?, self.exposure)
+    }
+
+    /// The guard on every frame: a non-finite pixel in the radiance makes the frame an error.
+    /// With TRANSLUCENT_CHECK_PASSES=1 the error names the first pass whose output holds a
+    /// non-finite value (sampling, irradiance, tree summaries, else shade).
+    fn check_finite(&self) -> Result<()> {
+        let Err(e) = output::check_finite(&self.image()?) else { return Ok(()) };
+        if std::env::var("TRANSLUCENT_CHECK_PASSES").is_ok_and(|v| !v.is_empty() && v != "0") {
+            let snapshot = self.hierarchy.download(&self.ctx)?;
+            let bad_point = |p: &crate::hierarchy::SurfacePoint| !(p.position.is_finite() && p.area.is_finite());
+            let pass = if snapshot.points.iter().any(bad_point) || snapshot.points.iter().any(|p| !p.normal.is_finite())
+            {
+                "sampling"
+            } else if snapshot.points.iter().any(|p| !(p.irradiance.is_finite() && p.light_dir.is_finite())) {
+                "irradiance"
+            } else if snapshot
+                .nodes
+                .iter()
+                .any(|n| !(n.power.is_finite() && n.power_center.is_finite() && n.area.is_finite()))
+            {
+                "tree summaries"
+            } else {
+                "shade"
+            };
+            return Err(crate::runtime!("{e}; the first pass with a non-finite output: {pass}"));
+        }
+        Err(e)
     }
 
     /// The last frame's linear radiance, read back from the GPU.

@@ -32,9 +32,23 @@ impl Mesh {
     /// Loads every object of an OBJ file into one mesh (triangulated, single index). Computes smooth
     /// area-weighted normals when the file has none or has unusable ones.
     pub fn load_obj(path: &Path) -> Result<Mesh> {
-        let shown = path.display();
-        let bytes = std::fs::read(path).map_err(|e| bad_input!("mesh {shown}: cannot read the file: {e}"))?;
-        let text = std::str::from_utf8(&bytes).map_err(|_| bad_input!("mesh {shown}: not an OBJ file (not text)"))?;
+        Mesh::from_obj_bytes(&read_mesh_file(path)?, &path.display().to_string())
+    }
+
+    /// Parses OBJ text (`shown` names it in errors). A UTF-8 byte-order mark is skipped and
+    /// old-Mac CR-only line endings are read as line ends, like LF and CRLF.
+    pub fn from_obj_bytes(bytes: &[u8], shown: &str) -> Result<Mesh> {
+        let text = std::str::from_utf8(bytes).map_err(|e| {
+            bad_input!("mesh {shown}: not an OBJ file (not UTF-8 text: byte {} is invalid)", e.valid_up_to() + 1)
+        })?;
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        let converted;
+        let text = if text.contains('\r') {
+            converted = text.replace("\r\n", "\n").replace('\r', "\n");
+            converted.as_str()
+        } else {
+            text
+        };
         check_obj_text(text).map_err(|why| bad_input!("mesh {shown}: {why}"))?;
 
         let options =
@@ -64,13 +78,12 @@ impl Mesh {
             }
         }
         mesh.validate().map_err(|e| bad_input!("mesh {shown}: {e}"))?;
-        let usable = have_normals && mesh.normals.iter().all(|n| n.is_finite() && n.length_squared() > 1e-12);
-        if usable {
-            for n in &mut mesh.normals {
-                *n = n.normalize();
-            }
-        } else {
-            mesh.compute_normals();
+        // Normalised safely: a normal such as (1e38, 1e38, 1e38) overflows f32 when squared.
+        let normalised: Option<Vec<Vec3>> =
+            if have_normals { mesh.normals.iter().map(|n| safe_normalize(*n)).collect() } else { None };
+        match normalised {
+            Some(n) => mesh.normals = n,
+            None => mesh.compute_normals(),
         }
         Ok(mesh)
     }
@@ -240,6 +253,50 @@ impl Mesh {
         }
         self
     }
+}
+
+/// The largest mesh file read (bytes): far above any real scan (the bunny is 3 MB), far below
+/// what would exhaust memory while parsing.
+pub const MAX_MESH_BYTES: u64 = 512 << 20;
+
+/// Reads a mesh file: a regular file of at most [`MAX_MESH_BYTES`]. A FIFO, a device such as
+/// /dev/zero or a folder is refused before it is opened, so nothing can block or read forever.
+fn read_mesh_file(path: &Path) -> Result<Vec<u8>> {
+    use std::io::Read;
+    let shown = path.display();
+    let meta = std::fs::metadata(path).map_err(|e| bad_input!("--mesh {shown}: cannot read the file: {e}"))?;
+    if !meta.is_file() {
+        return Err(bad_input!("--mesh {shown}: not a regular file (a folder, FIFO or device cannot be a mesh)"));
+    }
+    let too_big =
+        || bad_input!("--mesh {shown}: larger than the limit of {} MiB for a mesh file", MAX_MESH_BYTES >> 20);
+    if meta.len() > MAX_MESH_BYTES {
+        return Err(too_big());
+    }
+    let file = std::fs::File::open(path).map_err(|e| bad_input!("--mesh {shown}: cannot read the file: {e}"))?;
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    // Bounded even when the file grows while it is read.
+    file.take(MAX_MESH_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| bad_input!("--mesh {shown}: cannot read the file: {e}"))?;
+    if bytes.len() as u64 > MAX_MESH_BYTES {
+        return Err(too_big());
+    }
+    Ok(bytes)
+}
+
+/// `v` scaled to unit length, or `None` when it is zero or not finite. Divides by the largest
+/// component first, so vectors whose squared length overflows f32 (1e20, 1e20, 1e20) or
+/// underflows it (1e-30, 0, 0) normalise correctly.
+pub fn safe_normalize(v: Vec3) -> Option<Vec3> {
+    if !v.is_finite() {
+        return None;
+    }
+    let m = v.abs().max_element();
+    if m == 0.0 {
+        return None;
+    }
+    (v / m).try_normalize()
 }
 
 /// Checks tobj is lenient about: unknown statements are skipped silently (so garbage loads as an

@@ -155,10 +155,10 @@ unsafe extern "system" fn debug_callback(
         counts.errors.fetch_add(1, Ordering::SeqCst);
         // Straight to stderr, not through `log`: a finding must show whatever the logger setup
         // (tests have none).
-        eprintln!("vulkan validation error [{id}]: {message}");
+        crate::note!("vulkan validation error [{id}]: {message}");
     } else if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::WARNING) {
         counts.warnings.fetch_add(1, Ordering::SeqCst);
-        eprintln!("vulkan validation warning [{id}]: {message}");
+        crate::note!("vulkan validation warning [{id}]: {message}");
     } else {
         log::debug!("vulkan {types:?} [{id}]: {message}");
     }
@@ -320,7 +320,10 @@ fn choose_device(
     }
     let chosen = match wanted {
         Some(w) => {
-            let found = match w.parse::<usize>() {
+            if w.trim().parse::<i64>().is_ok_and(|i| i < 0) {
+                return Err(bad_input!("--device {w}: an index is 0 or more (`translucent devices` lists them)"));
+            }
+            let found = match w.trim().parse::<usize>() {
                 Ok(i) => devices.iter().find(|(_, d)| d.index == i),
                 Err(_) => {
                     let w = w.to_lowercase();
