@@ -9,7 +9,7 @@ use crate::error::Result;
 use crate::frame::{FrameOptions, Renderer, Show, SubsurfaceOptions};
 use crate::hierarchy::HierarchyOptions;
 use crate::materials::Material;
-use crate::mesh::Mesh;
+use crate::mesh::{safe_normalize, Mesh};
 use crate::output::Exposure;
 use crate::physics::{Diffusion, Model};
 use crate::scene::{Camera, Light, Scene};
@@ -319,7 +319,10 @@ fn light_spec(s: &str) -> std::result::Result<Light, String> {
     let v = vec3(at)?;
     let intensity = parts.next().map(rgb).transpose()?.unwrap_or(Vec3::ONE);
     let light = match kind {
-        "dir" => Light::Directional { toward: v, irradiance: intensity },
+        "dir" => Light::Directional {
+            toward: safe_normalize(v).ok_or_else(|| format!("'{s}': light direction {v} must be non-zero"))?,
+            irradiance: intensity,
+        },
         "point" => Light::Point { position: v, intensity },
         _ => return Err(format!("'{s}': the kind must be dir or point, not '{kind}'")),
     };
@@ -524,6 +527,14 @@ fn devices() -> Result<i32> {
     Ok(0)
 }
 
+/// The sizes (mm across) a mesh may have once --scale is applied: from a micrometre to a thousand
+/// kilometres, so that areas in mm² and the powers summed over them stay finite in f32.
+pub const SIZE_MM_LIMITS: (f64, f64) = (1e-3, 1e9);
+
+/// The largest coordinate accepted for --eye, --target and point lights: squared distances must
+/// stay finite in f32.
+pub const MAX_COORDINATE: f32 = 1e15;
+
 /// The Stanford bunny of Debian's glmark2-data, the default mesh when installed.
 pub const BUNNY: &str = "/usr/share/glmark2/models/bunny.obj";
 
@@ -539,8 +550,25 @@ pub fn mesh_spec(args: &RenderArgs) -> String {
 pub fn build_scene(args: &RenderArgs) -> Result<Scene> {
     let mesh = Mesh::from_spec(&mesh_spec(args))?;
     let (centre, radius) = crate::scene::bounding_sphere(&mesh.positions);
+    // The object's size in millimetres must stay where f32 areas and powers are finite.
+    let size_mm = 2.0 * radius as f64 * args.scale as f64;
+    if !(SIZE_MM_LIMITS.0..=SIZE_MM_LIMITS.1).contains(&size_mm) {
+        return Err(bad_input!(
+            "--scale {}: the mesh would be {size_mm:.3e} mm across; it must be within [{:e}, {:e}] mm",
+            args.scale,
+            SIZE_MM_LIMITS.0,
+            SIZE_MM_LIMITS.1
+        ));
+    }
     let mut camera = Camera::framing(centre, radius, args.fov, Vec3::new(0.3, 0.3, 1.0));
-    camera.up = args.up;
+    // Directions are normalised here, safely: (1e20, 1e20, 0) is a fine direction whose squared
+    // length overflows f32, and would otherwise turn into NaN on the GPU.
+    camera.up = safe_normalize(args.up).ok_or_else(|| bad_input!("--up {}: must be finite and non-zero", args.up))?;
+    for (flag, p) in [("--eye", args.eye), ("--target", args.target)] {
+        if let Some(p) = p.filter(|p| p.abs().max_element() > MAX_COORDINATE) {
+            return Err(bad_input!("{flag} {p}: coordinates must be within ±{MAX_COORDINATE:e}"));
+        }
+    }
     if let Some(target) = args.target {
         camera.target = target;
     }
@@ -548,10 +576,19 @@ pub fn build_scene(args: &RenderArgs) -> Result<Scene> {
         camera.eye = eye;
     }
     let lights = if args.lights.is_empty() {
-        vec![Light::Directional { toward: args.light_dir, irradiance: args.light_intensity }]
+        let toward = safe_normalize(args.light_dir)
+            .ok_or_else(|| bad_input!("--light-dir {}: light direction must be finite and non-zero", args.light_dir))?;
+        vec![Light::Directional { toward, irradiance: args.light_intensity }]
     } else {
         args.lights.clone()
     };
+    for light in &lights {
+        if let Light::Point { position, .. } = light {
+            if position.abs().max_element() > MAX_COORDINATE {
+                return Err(bad_input!("--light point:{position}: coordinates must be within ±{MAX_COORDINATE:e}"));
+            }
+        }
+    }
     if lights.len() > crate::passes::irradiance::MAX_LIGHTS {
         return Err(bad_input!(
             "--light: at most {} lights, {} given",
@@ -561,7 +598,28 @@ pub fn build_scene(args: &RenderArgs) -> Result<Scene> {
     }
     let scene = Scene { mesh, camera, lights, mm_per_unit: args.scale };
     scene.validate()?;
-    Ok(scene)
+    Ok(rescaled(scene, radius))
+}
+
+/// A scene whose mesh is far from unit size (a 1e-9-unit cube, a 1e8-unit terrain) re-expressed in
+/// units a power of two larger or smaller, so that its radius is near 1: the picture is the same
+/// (millimetres per unit change by the inverse factor, exactly), but the hierarchy's half-float
+/// node bounds and the depth range keep their precision.
+fn rescaled(mut scene: Scene, radius: f32) -> Scene {
+    if (1.0 / 64.0..=64.0).contains(&radius) || radius.is_nan() || radius <= 0.0 {
+        return scene;
+    }
+    let factor = (-radius.log2().round()).exp2();
+    scene.mesh = scene.mesh.scaled(factor);
+    scene.mm_per_unit /= factor;
+    scene.camera.eye *= factor;
+    scene.camera.target *= factor;
+    for light in &mut scene.lights {
+        if let Light::Point { position, .. } = light {
+            *position *= factor;
+        }
+    }
+    scene
 }
 
 fn check_output_path(path: &std::path::Path, flag: &str, allowed: &[&str]) -> Result<()> {
