@@ -143,6 +143,9 @@ fn parse_row(line: &str, line_number: usize) -> Result<Query> {
     to_query(&values).map_err(|why| bad_input!("bssrdf: line {line_number}, {why}"))
 }
 
+/// The largest position coordinate (mm): distances squared stay finite in f64.
+pub const MAX_COORDINATE_MM: f64 = 1e100;
+
 /// The largest σt = σa + σs (1/mm) that `--gpu` accepts: Sd grows about as σt², and past this
 /// it (or its intermediate terms) would leave f32's range.
 pub const GPU_MAX_SIGMA_T: f64 = 1e6;
@@ -170,12 +173,24 @@ fn to_query(v: &[f64; 19]) -> std::result::Result<Query, String> {
         if v[i] < 0.0 {
             return Err(format!("column {name}: {} is negative", v[i]));
         }
+        if v[i] > crate::materials::MAX_SIGMA {
+            return Err(format!("column {name}: {:e} is above {:e} /mm", v[i], crate::materials::MAX_SIGMA));
+        }
     }
     if v[2] <= -1.0 || v[2] >= 1.0 {
         return Err(format!("column g: {} is outside (−1, 1)", v[2]));
     }
-    if v[3] <= 0.0 {
-        return Err(format!("column eta: {} must be positive", v[3]));
+    if !(crate::materials::ETA_RANGE.0..=crate::materials::ETA_RANGE.1).contains(&v[3]) {
+        let (lo, hi) = crate::materials::ETA_RANGE;
+        return Err(format!("column eta: {} must be within [{lo}, {hi}]", v[3]));
+    }
+    // Squared distances must stay finite in f64.
+    for (i, name) in [(4, "xi"), (13, "xo")] {
+        for (k, axis) in ["x", "y", "z"].iter().enumerate() {
+            if v[i + k].abs() > MAX_COORDINATE_MM {
+                return Err(format!("column {name}_{axis}: {:e} is beyond ±{MAX_COORDINATE_MM:e} mm", v[i + k]));
+            }
+        }
     }
     let vec = |i: usize| DVec3::new(v[i], v[i + 1], v[i + 2]);
     // Scaled by the largest component first: (1e308, 1e308, 0) is a fine direction even though

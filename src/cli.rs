@@ -655,6 +655,14 @@ fn render(args: &RenderArgs) -> Result<i32> {
     }
     let mut scene = build_scene(args)?;
     let material = args.material.material()?;
+    // The GPU shades in f32 (see `bssrdf --gpu`).
+    if let Some(ch) = (0..3).find(|&c| material.sigma_a[c] + material.sigma_s[c] > crate::bssrdf_csv::GPU_MAX_SIGMA_T) {
+        return Err(bad_input!(
+            "--sigma-a/--sigma-s: σa + σs = {:e} /mm in channel {ch} is above {:e}, beyond what rendering in f32 can hold",
+            material.sigma_a[ch] + material.sigma_s[ch],
+            crate::bssrdf_csv::GPU_MAX_SIGMA_T
+        ));
+    }
     let ctx = Context::new(&args.device.options())?;
     let counts = ctx.validation_counts();
     let validating = ctx.validation;
