@@ -421,3 +421,36 @@ fn class7_tiny_meshes_are_framed() {
     assert!(ca > 100 && la > ca / 2, "{ca} {la}");
     assert!((cb as f32 / ca as f32 - 1.0).abs() < 0.1 && lb > cb / 2, "tiny cube: {cb} covered, {lb} lit; unit {ca}");
 }
+
+// 1. Coincident triangles: each pixel is shaded once whatever the mesh.
+
+#[test]
+fn class1_repeated_triangles_shade_each_pixel_once() {
+    let mut results = Vec::new();
+    for copies in [1, 300] {
+        let obj = tmp(&format!("repeated-{copies}.obj"));
+        let mut text = String::from("v -1 -1 0\nv 1 -1 0\nv 0 1 0\nv 0 0 -1\n");
+        for _ in 0..copies {
+            text += "f 1 2 3\nf 1 4 2\n";
+        }
+        std::fs::write(&obj, text).unwrap();
+        let exr = tmp(&format!("repeated-{copies}.exr"));
+        let start = Instant::now();
+        let out = run(
+            &["render", "--validation", "--profile", "--mesh", &obj, "--width", "32", "--height", "32", "--out", &exr],
+            120,
+        );
+        assert!(out.status.success(), "{copies} copies: {}", stderr(&out));
+        let text = String::from_utf8_lossy(&out.stdout).into_owned();
+        let pixels = text
+            .lines()
+            .find_map(|l| l.strip_prefix("work per pixel (last frame, "))
+            .and_then(|l| l.split(' ').next())
+            .unwrap_or_else(|| panic!("no work line in:\n{text}"))
+            .to_string();
+        results.push((pixels, std::fs::read(&exr).unwrap(), start.elapsed()));
+    }
+    assert_eq!(results[0].0, results[1].0, "shaded pixels: one copy vs 300 copies");
+    assert!(results[0].1 == results[1].1, "300 copies must give the same image as one");
+    println!("one copy {:?}, 300 copies {:?}", results[0].2, results[1].2);
+}
