@@ -133,6 +133,14 @@ pub fn run(options: &BenchOptions) -> Result<String> {
         let ctx = Context::new(&options.context)?;
         for &n in options.samples.iter().chain(&options.accuracy_samples) {
             hierarchy::check_point_count(&ctx, n)?;
+            let sizes = crate::budget::FrameSizes {
+                width: options.width,
+                height: options.height,
+                shadow_resolution: 1024,
+                shadow_layers: 2,
+                point_count: n,
+            };
+            crate::budget::check_frame(&ctx, &sizes)?;
         }
         if let Some(e) = options.epsilons.iter().find(|e| !(e.is_finite() && **e >= 0.0)) {
             return Err(crate::bad_input!("--epsilons: {e} must be a finite number ≥ 0"));

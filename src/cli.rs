@@ -676,6 +676,16 @@ fn render(args: &RenderArgs) -> Result<i32> {
         }
         None => default_point_count(&ctx, &scene, &material),
     };
+    crate::budget::check_frame(
+        &ctx,
+        &crate::budget::FrameSizes {
+            width: args.width,
+            height: args.height,
+            shadow_resolution: args.shadow_resolution,
+            shadow_layers: crate::budget::FrameSizes::shadow_layers(&scene.lights),
+            point_count,
+        },
+    )?;
     let show = match args.show {
         ShowArg::Shading => Show::Shading,
         ShowArg::Samples => Show::Samples,
@@ -726,6 +736,10 @@ fn render(args: &RenderArgs) -> Result<i32> {
     }
     bar.finish_and_clear();
     if !every_frame {
+        if args.width as u64 * args.height as u64 >= 1 << 22 {
+            // Encoding a large image takes seconds after the bar is gone: say what is happening.
+            crate::note!("writing {} ({}x{})…", args.out.display(), args.width, args.height);
+        }
         renderer.write_image(&args.out)?;
         crate::note!("wrote {} ({}x{}, {} frame(s))", args.out.display(), args.width, args.height, args.frames);
     }

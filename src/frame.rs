@@ -69,7 +69,7 @@ const SUBMISSION_TARGET_S: f64 = 0.2;
 /// submission's pool (`SETS_PER_SUBMIT` = 512 in src/vk/commands.rs).
 const MAX_UNITS_PER_SUBMISSION: usize = 256;
 
-/// What to draw over the shaded mesh for debugging.
+/// What to draw: the shaded mesh, or a debug view instead of it (the subsurface pass is skipped).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Show {
     Shading,
@@ -329,7 +329,9 @@ impl Renderer {
         })?;
 
         // Shading in several submissions, so that none runs long (see SUBMISSION_TARGET_S).
-        let units = self.units();
+        // A debug view costs what it draws: no subsurface shading under it (the pre-pass's depth
+        // still hides what is behind the surface).
+        let units = if self.show == Show::Shading { self.units() } else { Vec::new() };
         let mut done = 0;
         let (mut submissions, mut shading_seconds) = (0, 0.0);
         while done < units.len() {

@@ -454,3 +454,43 @@ fn class1_repeated_triangles_shade_each_pixel_once() {
     assert!(results[0].1 == results[1].1, "300 copies must give the same image as one");
     println!("one copy {:?}, 300 copies {:?}", results[0].2, results[1].2);
 }
+
+// 5. Sizes inside the flags' ranges that this device cannot hold: refused before anything is
+// created, naming the flag (before, the validation layer reported vkCreateImage).
+
+#[test]
+fn class5_images_beyond_the_device_are_refused_by_flag() {
+    let png = tmp("huge.png");
+    let start = Instant::now();
+    let out = run(
+        &["render", "--validation", "--mesh", "sphere", "--width", "16384", "--height", "16384", "--out", &png],
+        60,
+    );
+    assert_bad_input(&out, "--width/--height", "16384x16384");
+    let mut args = vec!["render", "--validation", "--mesh", "sphere", "--width", "16", "--height", "16"];
+    args.extend(["--shadow-resolution", "8192", "--out", &png]);
+    for p in ["point:3,3,3", "point:-3,3,3", "point:3,-3,3"] {
+        args.extend(["--light", p]);
+    }
+    let out = run(&args, 60);
+    assert_bad_input(&out, "--shadow-resolution", "three point lights at 8192");
+    assert!(!stderr(&out).contains("vulkan validation"), "{}", stderr(&out));
+    assert!(start.elapsed() < Duration::from_secs(30));
+}
+
+// 8. A debug view costs what it draws.
+
+#[test]
+fn class8_debug_views_skip_the_subsurface_pass() {
+    let png = tmp("samples.png");
+    for view in [&["--show", "samples"][..], &["--show", "tree", "--level", "2"][..]] {
+        let mut args =
+            vec!["render", "--validation", "--mesh", "sphere", "--width", "64", "--height", "64", "--out", &png];
+        args.extend(view);
+        let out = run(&args, 120);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let table = String::from_utf8_lossy(&out.stdout);
+        assert!(table.contains("depth pre-pass"), "{table}");
+        assert!(!table.lines().any(|l| l.starts_with("shade ")), "{view:?} ran the shade pass:\n{table}");
+    }
+}
