@@ -796,8 +796,8 @@ fn report_profile(device: &str, frames: Vec<Vec<vk::TimedScope>>, args: &RenderA
     };
     crate::error::write_stdout(&crate::profiling::format_table(&report))?;
     if let Some(path) = &args.profile_out {
-        std::fs::write(path, crate::profiling::chrome_trace_json(&report))
-            .map_err(|e| runtime!("--profile-out {}: {e}", path.display()))?;
+        crate::output::write_file(path, crate::profiling::chrome_trace_json(&report).as_bytes())
+            .map_err(|e| runtime!("--profile-out: {e}"))?;
     }
     Ok(())
 }

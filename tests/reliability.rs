@@ -154,6 +154,20 @@ fn class3_a_full_disk_is_an_error_not_success() {
         assert_runtime_failure(&out, "No space left", &format!("profile --out {link}"));
         std::fs::remove_file(&link).ok();
     }
+    // A render to a full disk, small enough to fit any write buffer: exit 1, not 0.
+    for (flag, name) in [("--out", "full-render.png"), ("--out", "full-render.exr"), ("--profile-out", "full.json")] {
+        let link = tmp(name);
+        std::fs::remove_file(&link).ok();
+        std::os::unix::fs::symlink("/dev/full", &link).unwrap();
+        let mut args = vec!["render", "--mesh", "sphere", "--width", "8", "--height", "8", flag, &link];
+        let other = tmp("full-other.png");
+        if flag == "--profile-out" {
+            args.extend(["--out", &other]);
+        }
+        let out = run(&args, 120);
+        assert_runtime_failure(&out, "No space left", &format!("render {flag} {link}"));
+        std::fs::remove_file(&link).ok();
+    }
 }
 
 #[test]
