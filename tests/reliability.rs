@@ -130,6 +130,17 @@ fn class2_full_or_closed_stdout_and_stderr_never_panic() {
     drop(reader);
     let out = bin().arg("materials").stdout(writer).stderr(Stdio::piped()).output().unwrap();
     assert_runtime_failure(&out, "stdout", "materials | (closed)");
+    // render's profile report on a closed pipe.
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let png = tmp("pipe.png");
+    let out = bin()
+        .args(["render", "--mesh", "sphere", "--width", "8", "--height", "8", "--out", &png])
+        .stdout(writer)
+        .stderr(Stdio::piped())
+        .output()
+        .unwrap();
+    assert_runtime_failure(&out, "stdout", "render | (closed)");
     // stderr on a full disk: the exit code still tells, no panic (101).
     for (args, code) in [(vec!["profile", "--sigma-s", "nan"], 2), (vec!["materials"], 0), (vec![], 2)] {
         let full = std::fs::File::create("/dev/full").unwrap();
@@ -182,9 +193,21 @@ fn class3_bssrdf_gpu_refuses_rows_beyond_f32() {
 
 #[test]
 fn class4_bssrdf_writes_output_before_the_input_ends() {
+    for args in [&[][..], &["--gpu", "--validation"][..]] {
+        bssrdf_streams(args);
+    }
+}
+
+fn bssrdf_streams(args: &[&str]) {
     let rows = translucent::bssrdf_csv::BATCH_ROWS + 10;
-    let mut child =
-        bin().arg("bssrdf").stdin(Stdio::piped()).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
+    let mut child = bin()
+        .arg("bssrdf")
+        .args(args)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
     let mut stdin = child.stdin.take().unwrap();
     let mut input = csv_header() + "\n";
     for _ in 0..rows {
@@ -213,7 +236,7 @@ fn class4_bssrdf_writes_output_before_the_input_ends() {
     drop(stdin);
     let mut rest = Vec::new();
     stdout.read_to_end(&mut rest).unwrap();
-    assert!(child.wait().unwrap().success());
+    assert!(child.wait().unwrap().success(), "{args:?}");
 }
 
 #[test]
