@@ -346,7 +346,7 @@ where
     );
 }
 
-const CI_CASES: u32 = 400;
+const CI_CASES: u32 = 1500;
 
 #[test]
 fn obj_reader_properties() {
