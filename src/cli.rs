@@ -636,6 +636,18 @@ fn check_output_path(path: &std::path::Path, flag: &str, allowed: &[&str]) -> Re
             return Err(bad_input!("{flag} {}: the folder {} does not exist", path.display(), dir.display()));
         }
     }
+    // Can it be written (permissions, a read-only file system)? Opened without truncating; a
+    // file created only for this test is removed again.
+    let first = frame_path(path, 0);
+    let existed = first.exists();
+    std::fs::OpenOptions::new()
+        .append(true)
+        .create(true)
+        .open(&first)
+        .map_err(|e| bad_input!("{flag} {}: cannot be written: {e}", first.display()))?;
+    if !existed {
+        std::fs::remove_file(&first).ok();
+    }
     Ok(())
 }
 

@@ -278,6 +278,11 @@ fn class6_output_paths_are_checked_first() {
     let out = run(&["profile", "--out", "/missing/p.png"], 30);
     assert_bad_input(&out, "--out /missing/p.png", "profile into a missing folder");
     assert!(!stderr(&out).contains("BackendError"));
+    // A place that cannot take a file (procfs refuses to create one, even for root).
+    let out = run(&["profile", "--out", "/proc/p.csv"], 30);
+    assert_bad_input(&out, "cannot be written", "profile into /proc");
+    let out = run(&["render", "--out", "/proc/r.png", "--mesh", "sphere"], 30);
+    assert_bad_input(&out, "--out /proc/r.png: cannot be written", "render into /proc");
 }
 
 #[test]
