@@ -128,6 +128,28 @@ fn mesh_name(spec: &str) -> &str {
 }
 
 pub fn run(options: &BenchOptions) -> Result<String> {
+    // Everything the user typed is checked before the first (long) configuration runs.
+    {
+        let ctx = Context::new(&options.context)?;
+        for &n in options.samples.iter().chain(&options.accuracy_samples) {
+            hierarchy::check_point_count(&ctx, n, 1)?;
+            let sizes = crate::budget::FrameSizes {
+                width: options.width,
+                height: options.height,
+                shadow_resolution: 1024,
+                shadow_layers: 2,
+                point_count: n,
+                light_count: 1,
+            };
+            crate::budget::check_frame(&ctx, &sizes)?;
+        }
+        if let Some(e) = options.epsilons.iter().find(|e| !(e.is_finite() && **e >= 0.0)) {
+            return Err(crate::bad_input!("--epsilons: {e} must be a finite number ≥ 0"));
+        }
+        for spec in &options.meshes {
+            Mesh::from_spec(spec)?;
+        }
+    }
     let mut out = String::new();
     let per_pixel = |w: &WorkCounters, sum: u32| if w.pixels > 0 { sum as f64 / w.pixels as f64 } else { 0.0 };
 
@@ -137,13 +159,9 @@ pub fn run(options: &BenchOptions) -> Result<String> {
         let scene = scene(spec)?;
         for &n in &options.samples {
             let size = (options.width, options.height);
-            let run = match run_one(&options.context, &scene, n, size, options.frames, DEFAULT_EPSILON, false, true) {
-                Ok(r) => r,
-                Err(e) => {
-                    out += &format!("| {} | {n} | — {e} |\n", mesh_name(spec));
-                    continue;
-                }
-            };
+            // An error (a bad --device, too many --samples for the device) ends the command with
+            // its exit code, rather than becoming a row of the table.
+            let run = run_one(&options.context, &scene, n, size, options.frames, DEFAULT_EPSILON, false, true)?;
             if !header_done {
                 out += &format!(
                     "### Every pass\n\nDevice: {}; {}x{}, back-lit marble, directional dipole, ε = {DEFAULT_EPSILON}; mean of {} frame(s) after one warm-up frame. Peak RSS is the process's high-water mark so far (on lavapipe GPU memory is host memory).\n\n",
@@ -168,7 +186,7 @@ pub fn run(options: &BenchOptions) -> Result<String> {
                 hierarchy::bytes_used(n, 1) as f64 / (1 << 20) as f64,
                 peak_rss_mib().unwrap_or(f64::NAN)
             );
-            eprintln!("bench: {} N={n} done", mesh_name(spec));
+            crate::note!("bench: {} N={n} done", mesh_name(spec));
         }
     }
     if options.accuracy_size == 0 {
@@ -199,7 +217,7 @@ pub fn run(options: &BenchOptions) -> Result<String> {
             per_pixel(&tree.work, tree.work.node_sum),
             100.0 * relative_rmse(&tree.image, &brute.image)
         );
-        eprintln!("bench: brute force N={n} done");
+        crate::note!("bench: brute force N={n} done");
         if sweep_reference.is_none() {
             sweep_reference = Some((n, brute));
         }
@@ -221,7 +239,7 @@ pub fn run(options: &BenchOptions) -> Result<String> {
                 per_pixel(&tree.work, tree.work.evaluation_sum),
                 100.0 * relative_rmse(&tree.image, &brute.image)
             );
-            eprintln!("bench: epsilon {eps} done");
+            crate::note!("bench: epsilon {eps} done");
         }
         // 4. Cost against the number of lights: each light is its own source.
         out += &format!(
@@ -239,7 +257,7 @@ pub fn run(options: &BenchOptions) -> Result<String> {
                 shade / count as f64,
                 per_pixel(&run.work, run.work.evaluation_sum)
             );
-            eprintln!("bench: {count} light(s) done");
+            crate::note!("bench: {count} light(s) done");
         }
     }
     Ok(out)

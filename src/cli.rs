@@ -9,7 +9,7 @@ use crate::error::Result;
 use crate::frame::{FrameOptions, Renderer, Show, SubsurfaceOptions};
 use crate::hierarchy::HierarchyOptions;
 use crate::materials::Material;
-use crate::mesh::Mesh;
+use crate::mesh::{safe_normalize, Mesh};
 use crate::output::Exposure;
 use crate::physics::{Diffusion, Model};
 use crate::scene::{Camera, Light, Scene};
@@ -45,23 +45,23 @@ pub struct BenchArgs {
     #[arg(long, value_delimiter = ',')]
     pub meshes: Option<Vec<String>>,
     /// Sample counts of the per-pass table.
-    #[arg(long, value_delimiter = ',', default_values = ["16384", "65536", "262144"])]
+    #[arg(long, allow_hyphen_values = true, value_delimiter = ',', value_parser = clap::value_parser!(u32).range(1..), default_values = ["16384", "65536", "262144"])]
     pub samples: Vec<u32>,
     /// Image size (square) of the brute-force comparison and the epsilon sweep; 0 skips them.
-    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(0..=4096))]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 64, value_parser = clap::value_parser!(u32).range(0..=4096))]
     pub accuracy_size: u32,
     /// Sample counts of the brute-force comparison (the first is also the epsilon sweep's).
-    #[arg(long, value_delimiter = ',', default_values = ["16384", "65536", "262144"])]
+    #[arg(long, allow_hyphen_values = true, value_delimiter = ',', value_parser = clap::value_parser!(u32).range(1..), default_values = ["16384", "65536", "262144"])]
     pub accuracy_samples: Vec<u32>,
     /// Epsilons of the sweep.
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true, default_values = ["0.4", "0.2", "0.1", "0.05", "0.025"])]
     pub epsilons: Vec<f32>,
-    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=16384))]
     pub width: u32,
-    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=16384))]
     pub height: u32,
     /// Frames per configuration (the first is a warm-up).
-    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(2..=1000))]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 3, value_parser = clap::value_parser!(u32).range(2..=1000))]
     pub frames: u32,
     #[command(flatten)]
     pub device: DeviceArgs,
@@ -152,7 +152,7 @@ impl MaterialArgs {
         }
         m.validate()?;
         if let Some(w) = m.warning() {
-            eprintln!("warning: {w}");
+            crate::note!("warning: {w}");
         }
         Ok(m)
     }
@@ -177,7 +177,7 @@ pub struct ProfileArgs {
     #[arg(long, value_enum, default_value = "classical")]
     pub diffusion: DiffusionArg,
     /// Points per curve.
-    #[arg(long, default_value_t = 200)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 200)]
     pub samples: usize,
     /// Output: .png, .svg or .csv.
     #[arg(long, short, default_value = "profile.png")]
@@ -188,7 +188,7 @@ pub struct ProfileArgs {
 #[derive(Args, Debug, Clone)]
 pub struct DeviceArgs {
     /// Device to use: an index from `translucent devices` or a substring of its name.
-    #[arg(long, value_name = "INDEX|NAME")]
+    #[arg(long, allow_hyphen_values = true, value_name = "INDEX|NAME")]
     pub device: Option<String>,
     /// Enable VK_LAYER_KHRONOS_validation with synchronization validation; any warning or error
     /// makes the exit code non-zero. Also enabled by TRANSLUCENT_VALIDATION=1.
@@ -255,13 +255,13 @@ pub struct RenderArgs {
     #[arg(long, allow_hyphen_values = true, value_parser = clap::value_parser!(u32))]
     pub samples: Option<u32>,
     /// Shadow-map resolution per light (per cube face for point lights).
-    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(16..=8192))]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(16..=8192))]
     pub shadow_resolution: u32,
     /// Draw a debug view over the mesh: the sample points or the tree's boxes at --level.
     #[arg(long, value_enum, default_value = "shading")]
     pub show: ShowArg,
     /// Tree level for `--show tree` (0 = the root).
-    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(0..=64))]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 4, value_parser = clap::value_parser!(u32).range(0..=64))]
     pub level: u32,
     #[command(flatten)]
     pub material: MaterialArgs,
@@ -320,7 +320,10 @@ fn light_spec(s: &str) -> std::result::Result<Light, String> {
     let v = vec3(at)?;
     let intensity = parts.next().map(rgb).transpose()?.unwrap_or(Vec3::ONE);
     let light = match kind {
-        "dir" => Light::Directional { toward: v, irradiance: intensity },
+        "dir" => Light::Directional {
+            toward: safe_normalize(v).ok_or_else(|| format!("'{s}': light direction {v} must be non-zero"))?,
+            irradiance: intensity,
+        },
         "point" => Light::Point { position: v, intensity },
         _ => return Err(format!("'{s}': the kind must be dir or point, not '{kind}'")),
     };
@@ -373,7 +376,7 @@ pub fn run(cli: Cli) -> Result<i32> {
         Command::Render(args) => render(&args),
         Command::Devices => devices(),
         Command::Materials => {
-            print!("{}", crate::materials::materials_table());
+            crate::error::write_stdout(&crate::materials::materials_table())?;
             Ok(0)
         }
         Command::Bssrdf(args) => bssrdf(&args),
@@ -398,42 +401,80 @@ pub fn run(cli: Cli) -> Result<i32> {
                 epsilons: args.epsilons.clone(),
                 context: args.device.options(),
             };
-            print!("{}", crate::bench::run(&options)?);
+            crate::error::write_stdout(&crate::bench::run(&options)?)?;
             Ok(0)
         }
     }
 }
 
 fn bssrdf(args: &BssrdfArgs) -> Result<i32> {
-    let stdin = std::io::stdin();
-    let queries = crate::bssrdf_csv::parse(stdin.lock())?;
+    use std::io::Write;
     let (model, diffusion) = (Model::from(args.model), Diffusion::from(args.diffusion));
-    let start = std::time::Instant::now();
-    let (sd, code) = if args.gpu {
+    let gpu = if args.gpu {
         let ctx = Context::new(&args.device.options())?;
-        let counts = ctx.validation_counts();
-        let validating = ctx.validation;
         let pass = crate::passes::bssrdf_eval::BssrdfEvalPass::new(&ctx)?;
-        let evaluation = std::time::Instant::now();
-        let sd: Vec<f64> = pass.evaluate(&ctx, &queries, model, diffusion)?.into_iter().map(f64::from).collect();
-        let seconds = evaluation.elapsed().as_secs_f64();
-        log::info!(
-            "GPU: {} rows in {seconds:.3} s ({:.3e} evaluations/s, upload and read-back included)",
-            queries.len(),
-            queries.len() as f64 / seconds
-        );
-        drop(pass);
-        drop(ctx);
-        (sd, validation_exit_code(validating, &counts))
+        Some((ctx, pass))
     } else {
-        (queries.iter().map(|q| q.sd(model, diffusion)).collect(), 0)
+        None
     };
-    log::info!("evaluated {} rows in {:.3} s", queries.len(), start.elapsed().as_secs_f64());
-    crate::bssrdf_csv::write(std::io::stdout().lock(), &queries, &sd)?;
-    Ok(code)
+    // Streamed: a batch of rows is read, evaluated and written before the next is read, so memory
+    // stays bounded and output starts at once, whatever the input's length.
+    let stdin = std::io::stdin();
+    let mut reader = crate::bssrdf_csv::Reader::new(stdin.lock());
+    let mut out = std::io::BufWriter::with_capacity(1 << 16, std::io::stdout().lock());
+    let start = std::time::Instant::now();
+    let mut rows = 0usize;
+    let mut header_written = false;
+    loop {
+        let batch = reader.next_batch(crate::bssrdf_csv::BATCH_ROWS)?;
+        if !header_written {
+            crate::bssrdf_csv::write_header(&mut out)?;
+            header_written = true;
+        }
+        if batch.is_empty() {
+            break;
+        }
+        let queries: Vec<crate::physics::Query> = batch.iter().map(|(_, q)| *q).collect();
+        let sd: Vec<f64> = match &gpu {
+            Some((ctx, pass)) => {
+                for (line, q) in &batch {
+                    crate::bssrdf_csv::gpu_range_check(q).map_err(|why| {
+                        bad_input!(
+                            "bssrdf --gpu: line {line}: {why}; the GPU evaluates in f32 (leave out --gpu to use f64)"
+                        )
+                    })?;
+                }
+                let sd = pass.evaluate(ctx, &queries, model, diffusion)?;
+                if let Some(i) = sd.iter().position(|v| !v.is_finite()) {
+                    return Err(runtime!(
+                        "bssrdf --gpu: line {}: the GPU returned {} (f32 overflow)",
+                        batch[i].0,
+                        sd[i]
+                    ));
+                }
+                sd.into_iter().map(f64::from).collect()
+            }
+            None => queries.iter().map(|q| q.sd(model, diffusion)).collect(),
+        };
+        crate::bssrdf_csv::write_rows(&mut out, &queries, &sd)?;
+        out.flush().map_err(|e| runtime!("stdout: {e}"))?;
+        rows += queries.len();
+    }
+    out.flush().map_err(|e| runtime!("stdout: {e}"))?;
+    log::info!("evaluated {rows} rows in {:.3} s", start.elapsed().as_secs_f64());
+    Ok(match gpu {
+        Some((ctx, pass)) => {
+            let (counts, validating) = (ctx.validation_counts(), ctx.validation);
+            drop(pass);
+            drop(ctx);
+            validation_exit_code(validating, &counts)
+        }
+        None => 0,
+    })
 }
 
 fn profile(args: &ProfileArgs) -> Result<i32> {
+    check_output_path(&args.out, "--out", &["png", "svg", "csv"])?;
     let material = args.material.material()?;
     let r_max = match args.r_max {
         Some(r) => r,
@@ -461,20 +502,20 @@ fn profile(args: &ProfileArgs) -> Result<i32> {
         samples: args.samples,
     };
     crate::plot::write_profile(&spec, &args.out)?;
-    eprintln!("wrote {}", args.out.display());
+    crate::note!("wrote {}", args.out.display());
     Ok(0)
 }
 
 fn devices() -> Result<i32> {
     let list = vk::list_devices()?;
-    println!("{:<5} {:<40} {:<15} {:<9} {:<10} driver", "index", "name", "type", "api", "timestamps");
+    let mut text = format!("{:<5} {:<40} {:<15} {:<9} {:<10} driver\n", "index", "name", "type", "api", "timestamps");
     for d in list {
         let usable = match &d.usable {
             Ok(()) => String::new(),
             Err(why) => format!("  (unusable: {why})"),
         };
-        println!(
-            "{:<5} {:<40} {:<15} {:<9} {:<10} {}{usable}",
+        text += &format!(
+            "{:<5} {:<40} {:<15} {:<9} {:<10} {}{usable}\n",
             d.index,
             d.name,
             d.type_name(),
@@ -483,8 +524,17 @@ fn devices() -> Result<i32> {
             d.driver
         );
     }
+    crate::error::write_stdout(&text)?;
     Ok(0)
 }
+
+/// The sizes (mm across) a mesh may have once --scale is applied: from a micrometre to a thousand
+/// kilometres, so that areas in mm² and the powers summed over them stay finite in f32.
+pub const SIZE_MM_LIMITS: (f64, f64) = (1e-3, 1e9);
+
+/// The largest coordinate accepted for --eye, --target and point lights: squared distances must
+/// stay finite in f32.
+pub const MAX_COORDINATE: f32 = 1e15;
 
 /// The Stanford bunny of Debian's glmark2-data, the default mesh when installed.
 pub const BUNNY: &str = "/usr/share/glmark2/models/bunny.obj";
@@ -501,8 +551,25 @@ pub fn mesh_spec(args: &RenderArgs) -> String {
 pub fn build_scene(args: &RenderArgs) -> Result<Scene> {
     let mesh = Mesh::from_spec(&mesh_spec(args))?;
     let (centre, radius) = crate::scene::bounding_sphere(&mesh.positions);
+    // The object's size in millimetres must stay where f32 areas and powers are finite.
+    let size_mm = 2.0 * radius as f64 * args.scale as f64;
+    if !(SIZE_MM_LIMITS.0..=SIZE_MM_LIMITS.1).contains(&size_mm) {
+        return Err(bad_input!(
+            "--scale {}: the mesh would be {size_mm:.3e} mm across; it must be within [{:e}, {:e}] mm",
+            args.scale,
+            SIZE_MM_LIMITS.0,
+            SIZE_MM_LIMITS.1
+        ));
+    }
     let mut camera = Camera::framing(centre, radius, args.fov, Vec3::new(0.3, 0.3, 1.0));
-    camera.up = args.up;
+    // Directions are normalised here, safely: (1e20, 1e20, 0) is a fine direction whose squared
+    // length overflows f32, and would otherwise turn into NaN on the GPU.
+    camera.up = safe_normalize(args.up).ok_or_else(|| bad_input!("--up {}: must be finite and non-zero", args.up))?;
+    for (flag, p) in [("--eye", args.eye), ("--target", args.target)] {
+        if let Some(p) = p.filter(|p| p.abs().max_element() > MAX_COORDINATE) {
+            return Err(bad_input!("{flag} {p}: coordinates must be within ±{MAX_COORDINATE:e}"));
+        }
+    }
     if let Some(target) = args.target {
         camera.target = target;
     }
@@ -510,10 +577,19 @@ pub fn build_scene(args: &RenderArgs) -> Result<Scene> {
         camera.eye = eye;
     }
     let lights = if args.lights.is_empty() {
-        vec![Light::Directional { toward: args.light_dir, irradiance: args.light_intensity }]
+        let toward = safe_normalize(args.light_dir)
+            .ok_or_else(|| bad_input!("--light-dir {}: light direction must be finite and non-zero", args.light_dir))?;
+        vec![Light::Directional { toward, irradiance: args.light_intensity }]
     } else {
         args.lights.clone()
     };
+    for light in &lights {
+        if let Light::Point { position, .. } = light {
+            if position.abs().max_element() > MAX_COORDINATE {
+                return Err(bad_input!("--light point:{position}: coordinates must be within ±{MAX_COORDINATE:e}"));
+            }
+        }
+    }
     if lights.len() > crate::passes::irradiance::MAX_LIGHTS {
         return Err(bad_input!(
             "--light: at most {} lights, {} given",
@@ -523,7 +599,28 @@ pub fn build_scene(args: &RenderArgs) -> Result<Scene> {
     }
     let scene = Scene { mesh, camera, lights, mm_per_unit: args.scale };
     scene.validate()?;
-    Ok(scene)
+    Ok(rescaled(scene, radius))
+}
+
+/// A scene whose mesh is far from unit size (a 1e-9-unit cube, a 1e8-unit terrain) re-expressed in
+/// units a power of two larger or smaller, so that its radius is near 1: the picture is the same
+/// (millimetres per unit change by the inverse factor, exactly), but the hierarchy's half-float
+/// node bounds and the depth range keep their precision.
+fn rescaled(mut scene: Scene, radius: f32) -> Scene {
+    if (1.0 / 64.0..=64.0).contains(&radius) || radius.is_nan() || radius <= 0.0 {
+        return scene;
+    }
+    let factor = (-radius.log2().round()).exp2();
+    scene.mesh = scene.mesh.scaled(factor);
+    scene.mm_per_unit /= factor;
+    scene.camera.eye *= factor;
+    scene.camera.target *= factor;
+    for light in &mut scene.lights {
+        if let Light::Point { position, .. } = light {
+            *position *= factor;
+        }
+    }
+    scene
 }
 
 fn check_output_path(path: &std::path::Path, flag: &str, allowed: &[&str]) -> Result<()> {
@@ -532,10 +629,25 @@ fn check_output_path(path: &std::path::Path, flag: &str, allowed: &[&str]) -> Re
         return Err(bad_input!("{flag} {}: the extension must be one of .{}", path.display(), allowed.join(", .")));
     }
     // Found out before a long render, not after it.
+    if path.is_dir() {
+        return Err(bad_input!("{flag} {}: is a folder; give a file name", path.display()));
+    }
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         if !dir.is_dir() {
             return Err(bad_input!("{flag} {}: the folder {} does not exist", path.display(), dir.display()));
         }
+    }
+    // Can it be written (permissions, a read-only file system)? Opened without truncating; a
+    // file created only for this test is removed again.
+    let first = frame_path(path, 0);
+    let existed = first.exists();
+    std::fs::OpenOptions::new()
+        .append(true)
+        .create(true)
+        .open(&first)
+        .map_err(|e| bad_input!("{flag} {}: cannot be written: {e}", first.display()))?;
+    if !existed {
+        std::fs::remove_file(&first).ok();
     }
     Ok(())
 }
@@ -556,6 +668,14 @@ fn render(args: &RenderArgs) -> Result<i32> {
     }
     let mut scene = build_scene(args)?;
     let material = args.material.material()?;
+    // The GPU shades in f32 (see `bssrdf --gpu`).
+    if let Some(ch) = (0..3).find(|&c| material.sigma_a[c] + material.sigma_s[c] > crate::bssrdf_csv::GPU_MAX_SIGMA_T) {
+        return Err(bad_input!(
+            "--sigma-a/--sigma-s: σa + σs = {:e} /mm in channel {ch} is above {:e}, beyond what rendering in f32 can hold",
+            material.sigma_a[ch] + material.sigma_s[ch],
+            crate::bssrdf_csv::GPU_MAX_SIGMA_T
+        ));
+    }
     let ctx = Context::new(&args.device.options())?;
     let counts = ctx.validation_counts();
     let validating = ctx.validation;
@@ -569,6 +689,17 @@ fn render(args: &RenderArgs) -> Result<i32> {
         }
         None => default_point_count(&ctx, &scene, &material),
     };
+    crate::budget::check_frame(
+        &ctx,
+        &crate::budget::FrameSizes {
+            width: args.width,
+            height: args.height,
+            shadow_resolution: args.shadow_resolution,
+            shadow_layers: crate::budget::FrameSizes::shadow_layers(&scene.lights),
+            point_count,
+            light_count: scene.lights.len() as u32,
+        },
+    )?;
     let show = match args.show {
         ShowArg::Shading => Show::Shading,
         ShowArg::Samples => Show::Samples,
@@ -614,13 +745,17 @@ fn render(args: &RenderArgs) -> Result<i32> {
         if every_frame {
             let path = frame_path(&args.out, index);
             renderer.write_image(&path)?;
-            bar.suspend(|| eprintln!("wrote {}", path.display()));
+            bar.suspend(|| crate::note!("wrote {}", path.display()));
         }
     }
     bar.finish_and_clear();
     if !every_frame {
+        if args.width as u64 * args.height as u64 >= 1 << 22 {
+            // Encoding a large image takes seconds after the bar is gone: say what is happening.
+            crate::note!("writing {} ({}x{})…", args.out.display(), args.width, args.height);
+        }
         renderer.write_image(&args.out)?;
-        eprintln!("wrote {} ({}x{}, {} frame(s))", args.out.display(), args.width, args.height, args.frames);
+        crate::note!("wrote {} ({}x{}, {} frame(s))", args.out.display(), args.width, args.height, args.frames);
     }
     let work = renderer.work()?;
     drop(renderer);
@@ -630,15 +765,15 @@ fn render(args: &RenderArgs) -> Result<i32> {
     }
     if args.profile && work.pixels > 0 {
         let per_pixel = |sum: u32| sum as f64 / work.pixels as f64;
-        println!(
-            "work per pixel (last frame, {} pixels): nodes visited mean {:.1} max {}, points evaluated mean {:.1} max {}, Sd evaluations mean {:.1}",
+        crate::error::write_stdout(&format!(
+            "work per pixel (last frame, {} pixels): nodes visited mean {:.1} max {}, points evaluated mean {:.1} max {}, Sd evaluations mean {:.1}\n",
             work.pixels,
             per_pixel(work.node_sum),
             work.node_max,
             per_pixel(work.point_sum),
             work.point_max,
             per_pixel(work.evaluation_sum)
-        );
+        ))?;
     }
     Ok(validation_exit_code(validating, &counts))
 }
@@ -656,11 +791,11 @@ fn default_point_count(ctx: &Context, scene: &Scene, material: &Material) -> u32
         .fold(f64::INFINITY, f64::min) as f32;
     let budget = crate::hierarchy::max_points(ctx, scene.lights.len() as u32).min(1 << 18);
     let (n, spacing) = crate::hierarchy::choose_point_count(area_mm2, shortest, budget);
-    eprintln!(
+    crate::note!(
         "samples: {n} points, {spacing:.3} mm apart on {area_mm2:.0} mm² (shortest of mean free path and diffusion length: {shortest:.3} mm)"
     );
     if spacing > shortest {
-        eprintln!("warning: points are spaced wider than the mean free path or diffusion length; raise --samples for accuracy");
+        crate::note!("warning: points are spaced wider than the mean free path or diffusion length; raise --samples for accuracy");
     }
     n
 }
@@ -674,10 +809,10 @@ fn report_profile(device: &str, frames: Vec<Vec<vk::TimedScope>>, args: &RenderA
             .map(|f| f.into_iter().map(|s| Scope { name: s.name, begin_ns: s.begin_ns, end_ns: s.end_ns }).collect())
             .collect(),
     };
-    print!("{}", crate::profiling::format_table(&report));
+    crate::error::write_stdout(&crate::profiling::format_table(&report))?;
     if let Some(path) = &args.profile_out {
-        std::fs::write(path, crate::profiling::chrome_trace_json(&report))
-            .map_err(|e| runtime!("--profile-out {}: {e}", path.display()))?;
+        crate::output::write_file(path, crate::profiling::chrome_trace_json(&report).as_bytes())
+            .map_err(|e| runtime!("--profile-out: {e}"))?;
     }
     Ok(())
 }
@@ -687,11 +822,35 @@ pub fn validation_exit_code(validating: bool, counts: &vk::ValidationCounts) -> 
     use std::sync::atomic::Ordering;
     let (w, e) = (counts.warnings.load(Ordering::SeqCst), counts.errors.load(Ordering::SeqCst));
     if w + e > 0 {
-        eprintln!("error: validation reported {e} error(s) and {w} warning(s)");
+        crate::note!("error: validation reported {e} error(s) and {w} warning(s)");
         return 1;
     }
     if validating {
         log::info!("validation: no messages");
     }
     0
+}
+
+/// What a clap error becomes: `--help` and `--version` print to stdout and exit 0 (1 when stdout
+/// cannot be written); a usage error prints `error: …` naming the flag and exits 2, and so does a
+/// bare `translucent` (clap would print only the help there, with no `error:` line).
+pub fn usage_exit(e: clap::Error) -> i32 {
+    use clap::error::ErrorKind;
+    match e.kind() {
+        ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => match e.print() {
+            Ok(()) => 0,
+            Err(_) => 1,
+        },
+        ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand | ErrorKind::MissingSubcommand => {
+            crate::note!(
+                "error: a command is required: render, devices, materials, bssrdf, profile or bench\n\n{}",
+                e.render()
+            );
+            2
+        }
+        _ => {
+            let _ = e.print();
+            2
+        }
+    }
 }

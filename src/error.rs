@@ -43,3 +43,23 @@ macro_rules! bad_input {
 macro_rules! runtime {
     ($($arg:tt)*) => { $crate::error::Error::Runtime(format!($($arg)*)) };
 }
+
+/// Writes `text` to stdout and flushes it. A failure (a full disk, a closed pipe: Rust ignores
+/// SIGPIPE, so a reader that went away shows up here as EPIPE) is a run-time error naming stdout,
+/// never a panic as `print!` would give.
+pub fn write_stdout(text: &str) -> Result<()> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    out.write_all(text.as_bytes()).and_then(|_| out.flush()).map_err(|e| Error::Runtime(format!("stdout: {e}")))
+}
+
+/// `note!("wrote {}", path)`: a line on stderr. Unlike `eprintln!` it cannot panic: when stderr
+/// itself cannot be written (`2>/dev/full`, a closed pipe) the line is dropped, since there is
+/// nowhere left to report it; the exit code still tells.
+#[macro_export]
+macro_rules! note {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr(), $($arg)*);
+    }};
+}

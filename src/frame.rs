@@ -75,7 +75,7 @@ const SUBMISSION_TARGET_S: f64 = 0.2;
 /// submission's pool (`SETS_PER_SUBMIT` = 512 in src/vk/commands.rs).
 const MAX_UNITS_PER_SUBMISSION: usize = 256;
 
-/// What to draw over the shaded mesh for debugging.
+/// What to draw: the shaded mesh, or a debug view instead of it (the subsurface pass is skipped).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Show {
     Shading,
@@ -338,7 +338,9 @@ impl Renderer {
         })?;
 
         // Shading in several submissions, so that none runs long (see SUBMISSION_TARGET_S).
-        let units = self.units();
+        // A debug view costs what it draws: no subsurface shading under it (the pre-pass's depth
+        // still hides what is behind the surface).
+        let units = if self.show == Show::Shading { self.units() } else { Vec::new() };
         let mut done = 0;
         let (mut submissions, mut shading_seconds) = (0, 0.0);
         while done < units.len() {
@@ -406,6 +408,7 @@ impl Renderer {
             rec.end_scope();
             Ok(())
         })?;
+        self.check_finite()?;
         Ok(self.profiler.as_mut().map(|p| p.take_scopes()).unwrap_or_default())
     }
 
@@ -425,9 +428,36 @@ impl Renderer {
         let ext = path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).unwrap_or_default();
         if ext == "png" {
             let image = self.tone_mapped_image()?;
-            return image.save(path).map_err(|e| crate::runtime!("cannot write {}: {e}", path.display()));
+            return output::write_file(path, &output::encode(image, image::ImageFormat::Png)?);
         }
         output::write_image(path, &self.image()?, self.exposure)
+    }
+
+    /// The guard on every frame: a non-finite pixel in the radiance makes the frame an error.
+    /// With TRANSLUCENT_CHECK_PASSES=1 the error names the first pass whose output holds a
+    /// non-finite value (sampling, irradiance, tree summaries, else shade).
+    fn check_finite(&self) -> Result<()> {
+        let Err(e) = output::check_finite(&self.image()?) else { return Ok(()) };
+        if std::env::var("TRANSLUCENT_CHECK_PASSES").is_ok_and(|v| !v.is_empty() && v != "0") {
+            let snapshot = self.hierarchy.download(&self.ctx)?;
+            let bad_point = |p: &crate::hierarchy::SurfacePoint| !(p.position.is_finite() && p.area.is_finite());
+            let pass = if snapshot.points.iter().any(bad_point) || snapshot.points.iter().any(|p| !p.normal.is_finite())
+            {
+                "sampling"
+            } else if snapshot.points.iter().any(|p| !(p.irradiance.is_finite() && p.light_dir.is_finite())) {
+                "irradiance"
+            } else if snapshot
+                .nodes
+                .iter()
+                .any(|n| !(n.power.is_finite() && n.center.is_finite() && n.area.is_finite()))
+            {
+                "tree summaries"
+            } else {
+                "shade"
+            };
+            return Err(crate::runtime!("{e}; the first pass with a non-finite output: {pass}"));
+        }
+        Err(e)
     }
 
     /// The last frame's linear radiance, read back from the GPU.

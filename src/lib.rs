@@ -3,6 +3,7 @@
 
 pub mod bench;
 pub mod bssrdf_csv;
+pub mod budget;
 pub mod cli;
 pub mod error;
 pub mod frame;

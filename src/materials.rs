@@ -81,6 +81,14 @@ fn key(name: &str) -> String {
     name.chars().filter(|c| c.is_alphanumeric()).flat_map(char::to_lowercase).collect()
 }
 
+/// The relative indices of refraction accepted: beyond these the Fresnel and diffusion terms
+/// lose their meaning (and, at 1e-100, their finiteness).
+/// The largest σa or σs accepted (1/mm): far past any measured material (those are below 1e4),
+/// and where σt² stays finite in f64.
+pub const MAX_SIGMA: f64 = 1e100;
+
+pub const ETA_RANGE: (f64, f64) = (0.1, 10.0);
+
 impl Material {
     pub fn presets() -> Vec<Material> {
         let jensen = JENSEN.iter().map(|(name, s_reduced, a)| Material {
@@ -123,6 +131,9 @@ impl Material {
                 if !v.is_finite() || *v < 0.0 {
                     return Err(bad_input!("{}: {what} = {v} in channel {ch} must be finite and ≥ 0", self.name));
                 }
+                if *v > MAX_SIGMA {
+                    return Err(bad_input!("{}: {what} = {v:e} in channel {ch} is above {MAX_SIGMA:e} /mm", self.name));
+                }
             }
         }
         for (ch, g) in self.g.iter().enumerate() {
@@ -130,8 +141,14 @@ impl Material {
                 return Err(bad_input!("{}: g = {g} in channel {ch} must lie in (−1, 1)", self.name));
             }
         }
-        if !self.eta.is_finite() || self.eta <= 0.0 {
-            return Err(bad_input!("{}: eta = {} must be finite and > 0", self.name, self.eta));
+        if !(ETA_RANGE.0..=ETA_RANGE.1).contains(&self.eta) {
+            return Err(bad_input!(
+                "{}: eta = {} must be finite and within [{}, {}]",
+                self.name,
+                self.eta,
+                ETA_RANGE.0,
+                ETA_RANGE.1
+            ));
         }
         Ok(())
     }

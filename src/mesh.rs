@@ -32,9 +32,23 @@ impl Mesh {
     /// Loads every object of an OBJ file into one mesh (triangulated, single index). Computes smooth
     /// area-weighted normals when the file has none or has unusable ones.
     pub fn load_obj(path: &Path) -> Result<Mesh> {
-        let shown = path.display();
-        let bytes = std::fs::read(path).map_err(|e| bad_input!("mesh {shown}: cannot read the file: {e}"))?;
-        let text = std::str::from_utf8(&bytes).map_err(|_| bad_input!("mesh {shown}: not an OBJ file (not text)"))?;
+        Mesh::from_obj_bytes(&read_mesh_file(path)?, &path.display().to_string())
+    }
+
+    /// Parses OBJ text (`shown` names it in errors). A UTF-8 byte-order mark is skipped and
+    /// old-Mac CR-only line endings are read as line ends, like LF and CRLF.
+    pub fn from_obj_bytes(bytes: &[u8], shown: &str) -> Result<Mesh> {
+        let text = std::str::from_utf8(bytes).map_err(|e| {
+            bad_input!("mesh {shown}: not an OBJ file (not UTF-8 text: byte {} is invalid)", e.valid_up_to() + 1)
+        })?;
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        let converted;
+        let text = if text.contains('\r') {
+            converted = text.replace("\r\n", "\n").replace('\r', "\n");
+            converted.as_str()
+        } else {
+            text
+        };
         check_obj_text(text).map_err(|why| bad_input!("mesh {shown}: {why}"))?;
 
         let options =
@@ -64,15 +78,99 @@ impl Mesh {
             }
         }
         mesh.validate().map_err(|e| bad_input!("mesh {shown}: {e}"))?;
-        let usable = have_normals && mesh.normals.iter().all(|n| n.is_finite() && n.length_squared() > 1e-12);
-        if usable {
-            for n in &mut mesh.normals {
-                *n = n.normalize();
+        // Inside-out meshes render dark: a closed mesh enclosing negative volume is wound inward.
+        if mesh.is_closed() && mesh.signed_volume() < 0.0 {
+            mesh.flip_winding();
+            crate::note!(
+                "warning: mesh {shown}: its triangles are wound inward (clockwise seen from outside); turned outward"
+            );
+        }
+        // Normalised safely: a normal such as (1e38, 1e38, 1e38) overflows f32 when squared.
+        let normalised: Option<Vec<Vec3>> =
+            if have_normals { mesh.normals.iter().map(|n| safe_normalize(*n)).collect() } else { None };
+        match normalised {
+            Some(n) => mesh.normals = n,
+            None => mesh.compute_normals(),
+        }
+        if mesh.normal_agreement() < 0.0 {
+            if mesh.is_closed() {
+                for n in &mut mesh.normals {
+                    *n = -*n;
+                }
+                crate::note!("warning: mesh {shown}: its vn normals point inward; turned outward");
+            } else {
+                crate::note!(
+                    "warning: mesh {shown}: most vn normals point against the triangles' winding; the surface may render dark"
+                );
             }
-        } else {
-            mesh.compute_normals();
         }
         Ok(mesh)
+    }
+
+    /// Whether every edge is shared by exactly two triangles, once in each direction (welded by
+    /// position, so duplicated vertices count as one): a closed, consistently wound surface.
+    pub fn is_closed(&self) -> bool {
+        // Welded on a grid a millionth of the mesh's size: a seam's two copies of a vertex
+        // (cos 0 and cos 2π) differ in the last bits.
+        let (lo, hi) = self.bounds();
+        let cell = ((hi - lo).max_element() as f64 * 1e-6).max(f64::MIN_POSITIVE);
+        let key = |i: u32| {
+            let p = (self.positions[i as usize] - lo).as_dvec3() / cell;
+            [p.x.round() as i64, p.y.round() as i64, p.z.round() as i64]
+        };
+        let mut edges: std::collections::HashMap<([i64; 3], [i64; 3]), i32> = std::collections::HashMap::new();
+        for t in self.indices.chunks_exact(3) {
+            for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+                let (ka, kb) = (key(a), key(b));
+                if ka == kb {
+                    continue;
+                }
+                // +1 for a → b, −1 for b → a, on the edge's sorted key.
+                let (k, sign) = if ka < kb { ((ka, kb), 1) } else { ((kb, ka), -1) };
+                *edges.entry(k).or_insert(0) += sign;
+            }
+        }
+        !edges.is_empty() && edges.values().all(|&v| v == 0)
+    }
+
+    /// The volume enclosed (positive when wound counter-clockwise seen from outside), about the
+    /// bounding box's centre; meaningful for a closed mesh.
+    pub fn signed_volume(&self) -> f64 {
+        let (lo, hi) = self.bounds();
+        let c = ((lo + hi) * 0.5).as_dvec3();
+        self.indices
+            .chunks_exact(3)
+            .map(|t| {
+                let [a, b, d] = [t[0], t[1], t[2]].map(|i| self.positions[i as usize].as_dvec3() - c);
+                a.dot(b.cross(d)) / 6.0
+            })
+            .sum()
+    }
+
+    /// Σ over triangles of the area-weighted agreement between the winding's normal and the
+    /// vertex normals: negative when the normals mostly point against the winding.
+    pub fn normal_agreement(&self) -> f64 {
+        self.indices
+            .chunks_exact(3)
+            .map(|t| {
+                let [a, b, c] = [t[0], t[1], t[2]].map(|i| self.positions[i as usize].as_dvec3());
+                let n: glam::DVec3 = [t[0], t[1], t[2]].iter().map(|&i| self.normals[i as usize].as_dvec3()).sum();
+                let g = (b - a).cross(c - a);
+                let m = g.abs().max_element();
+                if m > 0.0 {
+                    (g / m).dot(n).signum() * (g / m).length()
+                } else {
+                    0.0
+                }
+            })
+            .sum()
+    }
+
+    /// Reverses every triangle's winding (normals are left as they are).
+    pub fn flip_winding(&mut self) {
+        for t in self.indices.chunks_exact_mut(3) {
+            t.swap(1, 2);
+        }
     }
 
     /// Smooth vertex normals: each the area-weighted sum of the normals of the triangles that touch
@@ -220,8 +318,21 @@ impl Mesh {
         if let Some(&i) = self.indices.iter().find(|&&i| i as usize >= self.positions.len()) {
             return Err(bad_input!("vertex index {} is out of range ({} vertices)", i + 1, self.positions.len()));
         }
-        let area = self.surface_area();
         let (lo, hi) = self.bounds();
+        let largest = lo.abs().max(hi.abs()).max_element();
+        if largest > MAX_COORDINATE {
+            return Err(bad_input!(
+                "vertex coordinates reach {largest:e}: beyond ±{MAX_COORDINATE:e} squared areas overflow f32"
+            ));
+        }
+        if (hi - lo).max_element() < MIN_EXTENT {
+            return Err(bad_input!(
+                "the mesh is {:e} units across: below {MIN_EXTENT:e} squared areas underflow f32 (scale the file's \
+                 coordinates up and --scale down)",
+                (hi - lo).max_element()
+            ));
+        }
+        let area = self.surface_area();
         let scale = (hi - lo).max_element();
         if area.is_nan() || area <= 1e-12 * scale * scale || !area.is_finite() {
             return Err(bad_input!("the mesh has zero surface area (every triangle is degenerate)"));
@@ -240,6 +351,56 @@ impl Mesh {
         }
         self
     }
+}
+
+/// The largest vertex coordinate: a triangle's doubled area vector squared (an edge to the fourth
+/// power) must stay finite in f32.
+pub const MAX_COORDINATE: f32 = 1e9;
+/// The smallest extent of a mesh: the same fourth power must stay a normal f32.
+pub const MIN_EXTENT: f32 = 1e-9;
+
+/// The largest mesh file read (bytes): far above any real scan (the bunny is 3 MB), far below
+/// what would exhaust memory while parsing.
+pub const MAX_MESH_BYTES: u64 = 512 << 20;
+
+/// Reads a mesh file: a regular file of at most [`MAX_MESH_BYTES`]. A FIFO, a device such as
+/// /dev/zero or a folder is refused before it is opened, so nothing can block or read forever.
+fn read_mesh_file(path: &Path) -> Result<Vec<u8>> {
+    use std::io::Read;
+    let shown = path.display();
+    let meta = std::fs::metadata(path).map_err(|e| bad_input!("--mesh {shown}: cannot read the file: {e}"))?;
+    if !meta.is_file() {
+        return Err(bad_input!("--mesh {shown}: not a regular file (a folder, FIFO or device cannot be a mesh)"));
+    }
+    let too_big =
+        || bad_input!("--mesh {shown}: larger than the limit of {} MiB for a mesh file", MAX_MESH_BYTES >> 20);
+    if meta.len() > MAX_MESH_BYTES {
+        return Err(too_big());
+    }
+    let file = std::fs::File::open(path).map_err(|e| bad_input!("--mesh {shown}: cannot read the file: {e}"))?;
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    // Bounded even when the file grows while it is read.
+    file.take(MAX_MESH_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| bad_input!("--mesh {shown}: cannot read the file: {e}"))?;
+    if bytes.len() as u64 > MAX_MESH_BYTES {
+        return Err(too_big());
+    }
+    Ok(bytes)
+}
+
+/// `v` scaled to unit length, or `None` when it is zero or not finite. Divides by the largest
+/// component first, so vectors whose squared length overflows f32 (1e20, 1e20, 1e20) or
+/// underflows it (1e-30, 0, 0) normalise correctly.
+pub fn safe_normalize(v: Vec3) -> Option<Vec3> {
+    if !v.is_finite() {
+        return None;
+    }
+    let m = v.abs().max_element();
+    if m == 0.0 {
+        return None;
+    }
+    (v / m).try_normalize()
 }
 
 /// Checks tobj is lenient about: unknown statements are skipped silently (so garbage loads as an

@@ -150,19 +150,83 @@ pub fn rgba8_from_packed(width: u32, height: u32, packed: &[u32]) -> Result<imag
         .ok_or_else(|| runtime!("{n} packed pixels do not make a {width}x{height} image"))
 }
 
-/// Writes `.exr` (linear float RGBA, untouched) or `.png` (tone-mapped sRGB), by extension.
+/// Writes `bytes` to `path` and makes sure they arrived: every write error is reported, including
+/// the one a full disk gives only at `fsync` (delayed allocation), so a file that could not be
+/// written never passes for success. On error the partial file is removed.
+pub fn write_file(path: &Path, bytes: &[u8]) -> Result<()> {
+    use std::io::Write;
+    let fail = |e: std::io::Error| runtime!("cannot write {}: {e}", path.display());
+    let mut file = std::fs::File::create(path).map_err(fail)?;
+    let result = file.write_all(bytes).and_then(|_| file.flush()).and_then(|_| {
+        // Only regular files can be synced (a character device such as /dev/null cannot).
+        if file.metadata()?.is_file() {
+            file.sync_all()
+        } else {
+            Ok(())
+        }
+    });
+    if let Err(e) = result {
+        drop(file);
+        if std::fs::metadata(path).is_ok_and(|m| m.is_file()) {
+            std::fs::remove_file(path).ok();
+        }
+        return Err(fail(e));
+    }
+    Ok(())
+}
+
+/// Encodes an image (PNG or EXR, by `format`) in memory; see [`write_file`] for writing it.
+pub fn encode<I: Into<image::DynamicImage>>(img: I, format: image::ImageFormat) -> Result<Vec<u8>> {
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    img.into().write_to(&mut bytes, format).map_err(|e| runtime!("cannot encode the image: {e}"))?;
+    Ok(bytes.into_inner())
+}
+
+/// Writes `.exr` (linear float RGBA, untouched) or `.png` (tone-mapped sRGB), by extension. An
+/// image with a non-finite pixel is refused: no NaN or infinity reaches a file.
 pub fn write_image(path: &Path, img: &HdrImage, exposure: Exposure) -> Result<()> {
     let ext = path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).unwrap_or_default();
+    if !matches!(ext.as_str(), "exr" | "png") {
+        return Err(bad_input!("{}: unknown image format; use .png or .exr", path.display()));
+    }
+    check_finite(img)?;
     match ext.as_str() {
         "exr" => {
             let raw: Vec<f32> = img.pixels.iter().flatten().copied().collect();
             let buffer = image::Rgba32FImage::from_raw(img.width, img.height, raw).ok_or_else(|| {
                 runtime!("{}: pixel count does not match {}x{}", path.display(), img.width, img.height)
             })?;
-            buffer.save(path).map_err(|e| runtime!("cannot write {}: {e}", path.display()))
+            write_file(path, &encode(buffer, image::ImageFormat::OpenExr)?)
         }
-        "png" => tonemap(img, exposure).save(path).map_err(|e| runtime!("cannot write {}: {e}", path.display())),
-        _ => Err(bad_input!("{}: unknown image format; use .png or .exr", path.display())),
+        _ => write_file(path, &encode(tonemap(img, exposure), image::ImageFormat::Png)?),
+    }
+}
+
+/// The number of pixels with a NaN or infinite channel, and the first one (x, y).
+pub fn non_finite_pixels(img: &HdrImage) -> (usize, Option<(u32, u32)>) {
+    let mut first = None;
+    let mut count = 0;
+    for (i, p) in img.pixels.iter().enumerate() {
+        if !p.iter().all(|c| c.is_finite()) {
+            count += 1;
+            first = first.or(Some((i as u32 % img.width.max(1), i as u32 / img.width.max(1))));
+        }
+    }
+    (count, first)
+}
+
+/// A run-time error when any pixel is not finite: a frame with NaN or infinite radiance is a
+/// failure, never a picture.
+pub fn check_finite(img: &HdrImage) -> Result<()> {
+    match non_finite_pixels(img) {
+        (0, _) => Ok(()),
+        (n, first) => {
+            let (x, y) = first.unwrap_or_default();
+            Err(runtime!(
+                "the frame has {n} pixel(s) with non-finite radiance (NaN or infinity; the first at x={x}, y={y}); \
+                 no image is written (TRANSLUCENT_CHECK_PASSES=1 names the pass that produced it)"
+            ))
+        }
     }
 }
 

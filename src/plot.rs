@@ -15,6 +15,12 @@ use crate::materials::Material;
 use crate::physics::{Diffusion, Model, Query};
 use crate::{bad_input, runtime};
 
+/// The distances a profile may span, in mm.
+pub const R_LIMITS_MM: (f64, f64) = (1e-9, 1e9);
+
+/// The values a log axis shows: Sd outside this (zero, subnormal, overflowing) is left out.
+const SD_PLOTTABLE: (f64, f64) = (1e-290, 1e290);
+
 pub struct ProfileSpec {
     pub material: Material,
     pub models: Vec<Model>,
@@ -42,6 +48,17 @@ impl ProfileSpec {
                 "--r-min/--r-max: need 0 < r-min < r-max, got {} and {}",
                 self.r_min_mm,
                 self.r_max_mm
+            ));
+        }
+        // A log axis over more decades than this has nothing to show and makes the plotting
+        // library's tick search crawl.
+        if self.r_min_mm < R_LIMITS_MM.0 || self.r_max_mm > R_LIMITS_MM.1 {
+            return Err(bad_input!(
+                "--r-min/--r-max: {:e} and {:e} mm: both must be within [{:e}, {:e}] mm",
+                self.r_min_mm,
+                self.r_max_mm,
+                R_LIMITS_MM.0,
+                R_LIMITS_MM.1
             ));
         }
         if let Some(a) = self.angles_deg.iter().find(|a| !(0.0..90.0).contains(*a)) {
@@ -98,14 +115,42 @@ pub fn write_profile(spec: &ProfileSpec, path: &Path) -> Result<()> {
     spec.validate()?;
     let ext = path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).unwrap_or_default();
     let curves = spec.curves();
+    if !matches!(ext.as_str(), "csv" | "svg" | "png") {
+        return Err(bad_input!("--out {}: use .png, .svg or .csv", path.display()));
+    }
+    if ext == "csv" {
+        return write_csv(&curves, path);
+    }
+    if !curves.iter().flat_map(|c| &c.points).any(|p| plottable(p.1)) {
+        return Err(bad_input!(
+            "--out {}: Sd is zero (or outside [{:e}, {:e}]) at every distance for {} (σs = 0, or coefficients \
+             too small?): nothing to draw on a log axis; a .csv output lists the values",
+            path.display(),
+            SD_PLOTTABLE.0,
+            SD_PLOTTABLE.1,
+            spec.material.name
+        ));
+    }
     // Both backends lay text out with the font (SVG too, to measure it).
     register_font()?;
-    match ext.as_str() {
-        "csv" => write_csv(&curves, path),
-        "svg" => draw(spec, &curves, SVGBackend::new(path, (1100, 700)).into_drawing_area()),
-        "png" => draw(spec, &curves, BitMapBackend::new(path, (1100, 700)).into_drawing_area()),
-        _ => Err(bad_input!("--out {}: use .png, .svg or .csv", path.display())),
-    }
+    const SIZE: (u32, u32) = (1100, 700);
+    // Drawn in memory and written in one checked write (plotters' own file output can lose an
+    // error such as a full disk).
+    let bytes = if ext == "svg" {
+        let mut svg = String::new();
+        draw(spec, &curves, SVGBackend::with_string(&mut svg, SIZE).into_drawing_area())?;
+        svg.into_bytes()
+    } else {
+        let mut rgb = vec![0u8; (SIZE.0 * SIZE.1 * 3) as usize];
+        draw(spec, &curves, BitMapBackend::with_buffer(&mut rgb, SIZE).into_drawing_area())?;
+        let img = image::RgbImage::from_raw(SIZE.0, SIZE.1, rgb).ok_or_else(|| runtime!("plot: buffer size"))?;
+        crate::output::encode(img, image::ImageFormat::Png)?
+    };
+    crate::output::write_file(path, &bytes).map_err(|e| runtime!("--out: {e}"))
+}
+
+fn plottable(v: f64) -> bool {
+    v.is_finite() && v >= SD_PLOTTABLE.0 && v <= SD_PLOTTABLE.1
 }
 
 fn write_csv(curves: &[Curve], path: &Path) -> Result<()> {
@@ -117,7 +162,7 @@ fn write_csv(curves: &[Curve], path: &Path) -> Result<()> {
                 &format!("{r},{side},{},{},{},{sd}\n", model_name(c.model), c.angle_deg, ["r", "g", "b"][c.channel]);
         }
     }
-    std::fs::write(path, text).map_err(|e| runtime!("cannot write {}: {e}", path.display()))
+    crate::output::write_file(path, text.as_bytes()).map_err(|e| runtime!("--out: {e}"))
 }
 
 fn register_font() -> Result<()> {
@@ -134,11 +179,12 @@ fn draw<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| runtime!("plot: {e:?}");
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| runtime!("plot: {e}");
     root.fill(&WHITE).map_err(err)?;
-    let positive = curves.iter().flat_map(|c| c.points.iter().map(|p| p.1)).filter(|v| *v > 0.0);
-    let max = positive.clone().fold(0.0f64, f64::max).max(1e-30);
-    let min = positive.fold(f64::INFINITY, f64::min).max(max * 1e-12);
+    // The caller checked that some value is plottable; the axis spans at most 12 decades.
+    let positive = curves.iter().flat_map(|c| c.points.iter().map(|p| p.1)).filter(|v| plottable(*v));
+    let max = positive.clone().fold(SD_PLOTTABLE.0, f64::max);
+    let min = positive.fold(max, f64::min).max(max * 1e-12);
     let title = format!("{}: Sd vs distance in the plane of incidence (η = {})", spec.material.name, spec.material.eta);
     let mut chart = ChartBuilder::on(&root)
         .caption(title, ("sans-serif", 24))
@@ -161,7 +207,7 @@ where
         // Solid: forward side; lighter: backward. Thick: directional dipole; thin: classical.
         let shade = if c.side > 0.0 { colour.mix(1.0) } else { colour.mix(0.4) };
         let width = if c.model == Model::Directional { 2 } else { 1 };
-        let points = c.points.iter().filter(|p| p.1 > 0.0).copied();
+        let points = c.points.iter().filter(|p| plottable(p.1)).copied();
         let series = chart.draw_series(LineSeries::new(points, shade.stroke_width(width))).map_err(err)?;
         if c.channel == 0 {
             let side = if c.side > 0.0 { "forward" } else { "backward" };

@@ -19,7 +19,8 @@ impl Camera {
     /// A camera looking at a bounding sphere from `direction` (eye side), so that the whole sphere
     /// fits the vertical field of view.
     pub fn framing(centre: Vec3, radius: f32, fov_y_deg: f32, direction: Vec3) -> Camera {
-        let radius = radius.max(1e-6);
+        // Any size a mesh may have (Mesh::validate): no clamp that would lose a tiny object.
+        let radius = radius.max(1e-30);
         let half = (fov_y_deg.to_radians() * 0.5).max(1e-3);
         let distance = radius / half.sin() * 1.02;
         Camera { eye: centre + direction.normalize() * distance, target: centre, up: Vec3::Y, fov_y_deg }
@@ -30,7 +31,7 @@ impl Camera {
         if !(self.eye.is_finite() && self.target.is_finite() && self.up.is_finite()) {
             return Err(bad_input!("camera: --eye, --target and --up must be finite"));
         }
-        if forward.length() < 1e-9 {
+        if forward.length() <= 1e-6 * self.eye.abs().max_element().max(self.target.abs().max_element()) {
             return Err(bad_input!("camera: --eye and --target are the same point"));
         }
         if forward.cross(self.up).length() < 1e-6 * forward.length() * self.up.length().max(1e-30) {
@@ -46,7 +47,7 @@ impl Camera {
     pub fn view_projection(&self, aspect: f32, bounds: (Vec3, Vec3)) -> Mat4 {
         let view = Mat4::look_at_rh(self.eye, self.target, self.up);
         let centre = (bounds.0 + bounds.1) * 0.5;
-        let radius = ((bounds.1 - bounds.0).length() * 0.5).max(1e-6);
+        let radius = ((bounds.1 - bounds.0).length() * 0.5).max(1e-30);
         let distance = (centre - self.eye).length();
         let far = distance + radius * 1.5;
         let near = (distance - radius * 1.5).max(far * 1e-4);

@@ -13,7 +13,9 @@ use crate::vk::{
 };
 
 pub const COLOR_FORMAT: Format = Format::R32G32B32A32_SFLOAT;
-pub const DEPTH_FORMAT: Format = Format::D32_SFLOAT;
+/// Depth, and stencil to shade each pixel once even where triangles coincide (every copy of a
+/// repeated triangle passes the EQUAL depth test): see `GraphicsDesc::depth_equal`.
+pub const DEPTH_FORMAT: Format = Format::D32_SFLOAT_S8_UINT;
 
 /// Mirrors `ShadeConstants` in shaders/include/shade_constants.glsl (std430 push constants).
 #[repr(C)]
@@ -217,6 +219,9 @@ impl ShadePass {
         rec.prepare_draw_reads(&binds)?;
         rec.begin_rendering(&[(inputs.color, None)], Some((inputs.depth, None)), 0)?;
         rec.set_scissor(unit.x, unit.y, unit.width, unit.height);
+        // The pre-pass clears stencil to 0 and each draw over a pixel adds one: the draw of the
+        // k-th range of points expects k (mod 256, the stencil wraps).
+        rec.set_stencil_reference((unit.first_point / POINTS_PER_DRAW) & 0xff);
         let (v, i) = (Some(inputs.vertices), Some(inputs.indices));
         rec.draw(pipeline, &binds, vk::bytes_of(&c), v, i, inputs.index_count, 1)?;
         rec.end_rendering();

@@ -11,7 +11,7 @@ use ash::vk;
 use super::context::Context;
 use super::pipeline::{BindingKind, Pipeline};
 use super::profiler::GpuProfiler;
-use super::resources::{aspect_of, Access, Buffer, Image, Sampler, Transition};
+use super::resources::{aspect_of, has_stencil, Access, Buffer, Image, Sampler, Transition};
 use crate::error::Result;
 use crate::runtime;
 
@@ -386,8 +386,12 @@ impl<'a> Recorder<'a> {
             if clear.is_some() && img.layers == 1 {
                 self.discard_image(img);
             }
-            self.use_image(img, Access::DEPTH_ATTACHMENT)?;
+            let access =
+                if has_stencil(img.format) { Access::DEPTH_STENCIL_ATTACHMENT } else { Access::DEPTH_ATTACHMENT };
+            self.use_image(img, access)?;
         }
+        // A depth format with stencil is attached as both (stencil cleared to 0 with the depth).
+        let stencil = depth.is_some_and(|(img, _)| has_stencil(img.format));
         let extent = colors.first().map(|c| c.0.extent).or(depth.map(|d| d.0.extent)).unwrap_or_default();
         let views = |img: &Image| -> Result<vk::ImageView> {
             if img.layers == 1 {
@@ -415,7 +419,11 @@ impl<'a> Recorder<'a> {
                 Ok::<_, crate::Error>(
                     vk::RenderingAttachmentInfo::default()
                         .image_view(views(img)?)
-                        .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
+                        .image_layout(if has_stencil(img.format) {
+                            vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL
+                        } else {
+                            vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL
+                        })
                         .load_op(if clear.is_some() { vk::AttachmentLoadOp::CLEAR } else { vk::AttachmentLoadOp::LOAD })
                         .store_op(vk::AttachmentStoreOp::STORE)
                         .clear_value(vk::ClearValue {
@@ -428,6 +436,9 @@ impl<'a> Recorder<'a> {
         let mut info = vk::RenderingInfo::default().render_area(area).layer_count(1).color_attachments(&color_infos);
         if let Some(d) = &depth_info {
             info = info.depth_attachment(d);
+            if stencil {
+                info = info.stencil_attachment(d);
+            }
         }
         let viewport = vk::Viewport {
             x: 0.0,
@@ -459,6 +470,11 @@ impl<'a> Recorder<'a> {
         let rect =
             vk::Rect2D { offset: vk::Offset2D { x: x as i32, y: y as i32 }, extent: vk::Extent2D { width, height } };
         unsafe { self.device().cmd_set_scissor(self.cmd, 0, &[rect]) };
+    }
+
+    /// The stencil reference of pipelines that test it (see `GraphicsDesc::depth_equal`).
+    pub fn set_stencil_reference(&mut self, reference: u32) {
+        unsafe { self.device().cmd_set_stencil_reference(self.cmd, vk::StencilFaceFlags::FRONT_AND_BACK, reference) };
     }
 
     pub fn set_depth_bias(&mut self, constant: f32, slope: f32) {

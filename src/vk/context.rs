@@ -108,6 +108,7 @@ impl Drop for Shared {
 /// The Vulkan device the renderer runs on, with its one graphics + compute queue.
 pub struct Context {
     pub(crate) shared: Arc<Shared>,
+    pub(crate) physical_device: vk::PhysicalDevice,
     pub(crate) queue: vk::Queue,
     pub properties: vk::PhysicalDeviceProperties,
     pub info: DeviceInfo,
@@ -155,10 +156,10 @@ unsafe extern "system" fn debug_callback(
         counts.errors.fetch_add(1, Ordering::SeqCst);
         // Straight to stderr, not through `log`: a finding must show whatever the logger setup
         // (tests have none).
-        eprintln!("vulkan validation error [{id}]: {message}");
+        crate::note!("vulkan validation error [{id}]: {message}");
     } else if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::WARNING) {
         counts.warnings.fetch_add(1, Ordering::SeqCst);
-        eprintln!("vulkan validation warning [{id}]: {message}");
+        crate::note!("vulkan validation warning [{id}]: {message}");
     } else {
         log::debug!("vulkan {types:?} [{id}]: {message}");
     }
@@ -320,7 +321,10 @@ fn choose_device(
     }
     let chosen = match wanted {
         Some(w) => {
-            let found = match w.parse::<usize>() {
+            if w.trim().parse::<i64>().is_ok_and(|i| i < 0) {
+                return Err(bad_input!("--device {w}: an index is 0 or more (`translucent devices` lists them)"));
+            }
+            let found = match w.trim().parse::<usize>() {
                 Ok(i) => devices.iter().find(|(_, d)| d.index == i),
                 Err(_) => {
                     let w = w.to_lowercase();
@@ -510,6 +514,7 @@ impl Context {
         log::info!("device: {} ({}, {}, Vulkan {})", info.name, info.type_name(), info.driver, info.api_string());
         Ok(Context {
             shared,
+            physical_device: pd,
             queue,
             properties,
             info,
@@ -527,6 +532,40 @@ impl Context {
 
     pub fn limits(&self) -> &vk::PhysicalDeviceLimits {
         &self.properties.limits
+    }
+
+    /// What the driver allows for a 2D optimal-tiling image of `format` with `usage`
+    /// (`vkGetPhysicalDeviceImageFormatProperties`): maximum extent, layers and resource size.
+    /// `None` when the combination is not supported at all.
+    pub fn image_format_properties(
+        &self,
+        format: vk::Format,
+        usage: vk::ImageUsageFlags,
+    ) -> Option<vk::ImageFormatProperties> {
+        // SAFETY: valid physical device of this instance.
+        unsafe {
+            self.shared.instance.get_physical_device_image_format_properties(
+                self.physical_device,
+                format,
+                vk::ImageType::TYPE_2D,
+                vk::ImageTiling::OPTIMAL,
+                usage,
+                vk::ImageCreateFlags::empty(),
+            )
+        }
+        .ok()
+    }
+
+    /// The size of the largest device-local memory heap, in bytes.
+    pub fn largest_device_heap(&self) -> u64 {
+        // SAFETY: valid physical device of this instance.
+        let memory = unsafe { self.shared.instance.get_physical_device_memory_properties(self.physical_device) };
+        memory.memory_heaps[..memory.memory_heap_count as usize]
+            .iter()
+            .filter(|h| h.flags.contains(vk::MemoryHeapFlags::DEVICE_LOCAL))
+            .map(|h| h.size)
+            .max()
+            .unwrap_or(0)
     }
 
     /// Validation message counts; keep the `Arc` to read them after the context is dropped

@@ -116,6 +116,18 @@ impl Access {
         ),
         vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
     );
+    /// A depth attachment whose format also has stencil (both aspects in one layout).
+    pub const DEPTH_STENCIL_ATTACHMENT: Access = Access::new(
+        vk::PipelineStageFlags2::from_raw(
+            vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS.as_raw()
+                | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS.as_raw(),
+        ),
+        vk::AccessFlags2::from_raw(
+            vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE.as_raw()
+                | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ.as_raw(),
+        ),
+        vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL,
+    );
     pub const TRANSFER_READ: Access = Access::new(
         vk::PipelineStageFlags2::TRANSFER,
         vk::AccessFlags2::TRANSFER_READ,
@@ -313,6 +325,11 @@ pub struct Image {
     pub layers: u32,
     pub name: String,
     pub(crate) state: Cell<TrackedState>,
+}
+
+/// Whether a depth format also has a stencil aspect.
+pub(crate) fn has_stencil(format: vk::Format) -> bool {
+    aspect_of(format).contains(vk::ImageAspectFlags::STENCIL)
 }
 
 pub(crate) fn aspect_of(format: vk::Format) -> vk::ImageAspectFlags {
