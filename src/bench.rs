@@ -29,7 +29,55 @@ pub struct BenchOptions {
     /// Sample counts of the brute-force comparison.
     pub accuracy_samples: Vec<u32>,
     pub epsilons: Vec<f32>,
+    /// Image size (square) of the pbrt-v2 comparison; 0 skips it.
+    pub peer_size: u32,
     pub context: ContextOptions,
+}
+
+/// pbrt-v2's DipoleSubsurfaceIntegrator (Jensen–Buhler octree, CPU) on this machine kind (2 cores):
+/// a 10 mm skin1 sphere at 512×512 and 4 samples per pixel, about 3,100 irradiance points,
+/// maxerror 0.05, in 15.5 s for 764,696 lookups (issue #10).
+const PBRT_V2_SECONDS: f64 = 15.5;
+const PBRT_V2_LOOKUPS: f64 = 764_696.0;
+
+/// pbrt-v2's scene: a 256×128 UV sphere of radius 1 (10 mm), skin1 with the classical dipole, a
+/// distant light toward (0.5, 1, 1) with L = 3, camera at (0, 0, 4) looking at the origin, fov 30°.
+fn peer_scene() -> Scene {
+    let camera = Camera { eye: Vec3::new(0.0, 0.0, 4.0), target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 30.0 };
+    let toward = Vec3::new(0.333_333_3, 0.666_666_7, 0.666_666_7);
+    let lights = vec![Light::Directional { toward, irradiance: Vec3::splat(3.0) }];
+    Scene { mesh: Mesh::sphere(1.0, 128), camera, lights, mm_per_unit: 10.0 }
+}
+
+/// The pbrt-v2 comparison: the whole frame (rebuild included) at `size`², its lookups (shaded
+/// pixels) per second against pbrt-v2's, and the tree's error against brute force at 128².
+fn peer_comparison(options: &BenchOptions) -> Result<String> {
+    let size = options.peer_size;
+    let scene = peer_scene();
+    let material = crate::materials::Material::find("skin1")?;
+    let model = crate::physics::Model::Dipole;
+    let (n, epsilon) = (3100, 0.05);
+    let started = std::time::Instant::now();
+    let run = run_with(&options.context, &scene, (&material, model), n, (size, size), 2, epsilon, false, false)?;
+    let wall = started.elapsed().as_secs_f64();
+    let frame_s = pass_ms(&run, "frame") / 1e3;
+    let lookups = run.work.pixels as f64;
+    let per_pixel = |sum: u32| if run.work.pixels > 0 { sum as f64 / lookups } else { 0.0 };
+    let pbrt_rate = PBRT_V2_LOOKUPS / PBRT_V2_SECONDS;
+    let rate = lookups / frame_s;
+    let accuracy = 128;
+    let brute =
+        run_with(&options.context, &scene, (&material, model), n, (accuracy, accuracy), 2, epsilon, true, false)?;
+    let tree =
+        run_with(&options.context, &scene, (&material, model), n, (accuracy, accuracy), 2, epsilon, false, false)?;
+    crate::note!("bench: pbrt-v2 scene done");
+    Ok(format!(
+        "\n### Against pbrt-v2\n\npbrt-v2's dipole integrator scene (10 mm skin1 sphere, classical dipole, {n} points, ε = {epsilon}); pbrt-v2: {PBRT_V2_LOOKUPS} lookups in {PBRT_V2_SECONDS} s on this machine kind ({pbrt_rate:.0}/s). Frame: GPU timestamps of one frame after a warm-up, rebuild included; process: both frames, context and pipelines included.\n\n| size | lookups | frame s | lookups/s | × pbrt-v2 | nodes visited/px | Sd evaluations/px | process s | relative RMSE vs brute force at {accuracy}² |\n|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n| {size}² | {lookups:.0} | {frame_s:.2} | {rate:.0} | {:.2}× | {:.1} | {:.1} | {wall:.1} | {:.3}% |\n",
+        rate / pbrt_rate,
+        per_pixel(run.work.node_sum),
+        per_pixel(run.work.evaluation_sum),
+        100.0 * relative_rmse(&tree.image, &brute.image)
+    ))
 }
 
 /// The default scene's set-up (back-lit marble) for `mesh`.
@@ -60,13 +108,31 @@ fn run_one(
     brute_force: bool,
     specular: bool,
 ) -> Result<Run> {
+    let material = crate::materials::Material::find("marble")?;
+    let model = crate::physics::Model::Directional;
+    run_with(context, scene, (&material, model), n, size, frames, epsilon, brute_force, specular)
+}
+
+/// `run_one` with a material and model of its own.
+#[allow(clippy::too_many_arguments)]
+fn run_with(
+    context: &ContextOptions,
+    scene: &Scene,
+    (material, model): (&crate::materials::Material, crate::physics::Model),
+    n: u32,
+    size: (u32, u32),
+    frames: u32,
+    epsilon: f32,
+    brute_force: bool,
+    specular: bool,
+) -> Result<Run> {
     let ctx = Context::new(context)?;
     hierarchy::check_point_count(&ctx, n, scene.lights.len() as u32)?;
     let device = format!("{} ({})", ctx.info.name, ctx.info.driver);
     let options = FrameOptions {
         subsurface: SubsurfaceOptions {
-            material: crate::materials::Material::find("marble")?,
-            model: crate::physics::Model::Directional,
+            material: material.clone(),
+            model,
             diffusion: crate::physics::Diffusion::Classical,
             epsilon,
             brute_force,
@@ -190,6 +256,9 @@ pub fn run(options: &BenchOptions) -> Result<String> {
         }
     }
     if options.accuracy_size == 0 {
+        if options.peer_size > 0 {
+            out += &peer_comparison(options)?;
+        }
         return Ok(out);
     }
 
@@ -259,6 +328,10 @@ pub fn run(options: &BenchOptions) -> Result<String> {
             );
             crate::note!("bench: {count} light(s) done");
         }
+    }
+    // 5. The peer users would pick instead.
+    if options.peer_size > 0 {
+        out += &peer_comparison(options)?;
     }
     Ok(out)
 }

@@ -63,6 +63,10 @@ pub struct BenchArgs {
     /// Frames per configuration (the first is a warm-up).
     #[arg(long, allow_hyphen_values = true, default_value_t = 3, value_parser = clap::value_parser!(u32).range(2..=1000))]
     pub frames: u32,
+    /// Image size (square) of the comparison with pbrt-v2 on its own scene (it builds the UV
+    /// sphere itself); 0 skips it.
+    #[arg(long, allow_hyphen_values = true, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(0..=16384))]
+    pub peer_size: u32,
     #[command(flatten)]
     pub device: DeviceArgs,
 }
@@ -399,6 +403,7 @@ pub fn run(cli: Cli) -> Result<i32> {
                 accuracy_size: args.accuracy_size,
                 accuracy_samples: args.accuracy_samples.clone(),
                 epsilons: args.epsilons.clone(),
+                peer_size: args.peer_size,
                 context: args.device.options(),
             };
             crate::error::write_stdout(&crate::bench::run(&options)?)?;
