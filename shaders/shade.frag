@@ -131,9 +131,10 @@ void main() {
                     if (points[index].irradiance == vec3(0.0)) continue;
                 }
             } else {
-                TreeNode node = nodes[index];
-                ni = decode_oct(node.normal_oct);
+                // A continuation needs only the node's normal: the rest is loaded on its first visit.
+                ni = decode_oct(nodes[index].normal_oct);
                 if (next == 0u) {
+                    TreeNode node = nodes[index];
                     ++visits;
                     if (node.power == vec3(0.0)) continue;
                     vec3 lo, hi;
