@@ -37,6 +37,8 @@ pub enum Command {
     Profile(Box<ProfileArgs>),
     /// Time every pass (GPU timestamps) for several sample counts and meshes; prints Markdown.
     Bench(BenchArgs),
+    /// Show the scene in a window: orbit camera, light and material edits, scripted runs.
+    View(Box<crate::view::ViewArgs>),
 }
 
 #[derive(Args, Debug)]
@@ -312,7 +314,7 @@ fn triple(s: &str) -> std::result::Result<[f64; 3], String> {
     }
 }
 
-fn light_spec(s: &str) -> std::result::Result<Light, String> {
+pub(crate) fn light_spec(s: &str) -> std::result::Result<Light, String> {
     let mut parts = s.splitn(3, ':');
     let kind = parts.next().unwrap_or("");
     let at = parts.next().ok_or_else(|| format!("'{s}': expected dir:X,Y,Z[:I] or point:X,Y,Z[:I]"))?;
@@ -377,6 +379,7 @@ pub fn run(cli: Cli) -> Result<i32> {
         }
         Command::Bssrdf(args) => bssrdf(&args),
         Command::Profile(args) => profile(&args),
+        Command::View(args) => crate::view::run(&args),
         Command::Bench(args) => {
             let bunny = BUNNY;
             let meshes = args.meshes.clone().unwrap_or_else(|| {
@@ -644,7 +647,7 @@ fn render(args: &RenderArgs) -> Result<i32> {
 /// Sample count from the material's shortest length scale (mean free path 1/σ't or diffusion
 /// length 1/σtr) and the mesh's area (in mm), within a budget; prints the choice and warns when
 /// points are farther apart than that length.
-fn default_point_count(ctx: &Context, scene: &Scene, material: &Material) -> u32 {
+pub(crate) fn default_point_count(ctx: &Context, scene: &Scene, material: &Material) -> u32 {
     let mm = scene.mm_per_unit;
     let area_mm2 = scene.mesh.surface_area() * mm * mm;
     let shortest = (0..3)

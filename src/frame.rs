@@ -190,32 +190,13 @@ impl Renderer {
             &scene.mesh.indices,
             BufferUsageFlags::INDEX_BUFFER | BufferUsageFlags::STORAGE_BUFFER,
         )?;
-        let color = Image::new_2d(
-            &ctx,
-            "hdr colour",
-            shade::COLOR_FORMAT,
-            extent,
-            1,
-            ImageUsageFlags::COLOR_ATTACHMENT | ImageUsageFlags::TRANSFER_SRC | ImageUsageFlags::STORAGE,
-        )?;
-        let depth =
-            Image::new_2d(&ctx, "depth", shade::DEPTH_FORMAT, extent, 1, ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT)?;
-        let readback_bytes = width as u64 * height as u64 * 16;
-        let readback =
-            Buffer::new(&ctx, "readback", readback_bytes, BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)?;
+        let Targets { color, depth, readback, ldr } = Targets::new(&ctx, extent)?;
         let histogram = Buffer::new(
             &ctx,
             "luminance histogram",
             tonemap::histogram_bytes(),
             BufferUsageFlags::STORAGE_BUFFER | BufferUsageFlags::TRANSFER_DST,
             MemoryLocation::GpuOnly,
-        )?;
-        let ldr = Buffer::new(
-            &ctx,
-            "tone-mapped image",
-            tonemap::ldr_bytes(width, height),
-            BufferUsageFlags::STORAGE_BUFFER,
-            MemoryLocation::GpuToCpu,
         )?;
         let shade = ShadePass::new(&ctx)?;
         let hierarchy = Hierarchy::new(&ctx, &scene.mesh, &scene.lights, &hierarchy)?;
@@ -266,6 +247,62 @@ impl Renderer {
             extent,
             ctx,
         })
+    }
+
+    /// Renders `width` x `height` images from the next frame on (the window's size, or a preview
+    /// of it); only the size-dependent targets are made again.
+    pub fn set_size(&mut self, width: u32, height: u32) -> Result<()> {
+        let max = self.ctx.limits().max_image_dimension2_d;
+        if width == 0 || height == 0 || width > max || height > max {
+            return Err(bad_input!("image size {width}x{height}: width and height must be between 1 and {max}"));
+        }
+        let extent = Extent2D { width, height };
+        if extent == self.extent {
+            return Ok(());
+        }
+        // A window's copy of the last image may still be reading these targets.
+        self.ctx.wait_idle()?;
+        let Targets { color, depth, readback, ldr } = Targets::new(&self.ctx, extent)?;
+        (self.color, self.depth, self.readback, self.ldr, self.extent) = (color, depth, readback, ldr, extent);
+        // Learn again whether a frame of this size fits one submission.
+        if !self.tile_fixed {
+            self.whole_frame = false;
+            self.units_per_submission = 1;
+        }
+        Ok(())
+    }
+
+    /// The size of the images rendered.
+    pub fn extent(&self) -> Extent2D {
+        self.extent
+    }
+
+    /// Material, model, ε, brute force and specular for the next frame (the work counting set at
+    /// creation is kept). The hierarchy keeps the η it was built with.
+    pub fn set_subsurface(&mut self, subsurface: &SubsurfaceOptions, mm_per_unit: f32) -> Result<()> {
+        if !(subsurface.epsilon.is_finite() && subsurface.epsilon >= 0.0) {
+            return Err(bad_input!("epsilon {}: must be a finite number ≥ 0", subsurface.epsilon));
+        }
+        if !(subsurface.roughness > 0.0 && subsurface.roughness <= 1.0) {
+            return Err(bad_input!("roughness {}: must be in (0, 1]", subsurface.roughness));
+        }
+        let count_work = self.subsurface_params.read::<SubsurfaceParams>(1)?[0].count_work;
+        let mut params = subsurface_params(subsurface, mm_per_unit, self.hierarchy.point_count);
+        params.count_work = count_work;
+        self.subsurface_params.write(0, &[params])?;
+        self.brute_force = subsurface.brute_force;
+        Ok(())
+    }
+
+    /// Exposure of the tone-mapped image from the next frame on.
+    pub fn set_exposure(&mut self, exposure: Exposure) {
+        self.exposure = exposure;
+    }
+
+    /// The last frame tone-mapped on the GPU: one packed RGBA8 pixel per u32 (R in the low byte),
+    /// rows of `extent().width`; a transfer source, e.g. for copying into a window's image.
+    pub fn tone_mapped_buffer(&self) -> &Buffer {
+        &self.ldr
     }
 
     fn units(&self) -> Vec<shade::ShadeUnit> {
@@ -426,6 +463,41 @@ impl Renderer {
         let count = (self.extent.width * self.extent.height) as usize;
         let pixels = self.readback.read::<[f32; 4]>(count)?;
         Ok(HdrImage { width: self.extent.width, height: self.extent.height, pixels })
+    }
+}
+
+/// The images and buffers whose size is the frame's.
+struct Targets {
+    color: Image,
+    depth: Image,
+    readback: Buffer,
+    ldr: Buffer,
+}
+
+impl Targets {
+    fn new(ctx: &Context, extent: Extent2D) -> Result<Targets> {
+        let color = Image::new_2d(
+            ctx,
+            "hdr colour",
+            shade::COLOR_FORMAT,
+            extent,
+            1,
+            ImageUsageFlags::COLOR_ATTACHMENT | ImageUsageFlags::TRANSFER_SRC | ImageUsageFlags::STORAGE,
+        )?;
+        let depth =
+            Image::new_2d(ctx, "depth", shade::DEPTH_FORMAT, extent, 1, ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT)?;
+        let readback_bytes = extent.width as u64 * extent.height as u64 * 16;
+        let readback =
+            Buffer::new(ctx, "readback", readback_bytes, BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)?;
+        let ldr = Buffer::new(
+            ctx,
+            "tone-mapped image",
+            tonemap::ldr_bytes(extent.width, extent.height),
+            // TRANSFER_SRC: `view` copies it into the window's image.
+            BufferUsageFlags::STORAGE_BUFFER | BufferUsageFlags::TRANSFER_SRC,
+            MemoryLocation::GpuToCpu,
+        )?;
+        Ok(Targets { color, depth, readback, ldr })
     }
 }
 

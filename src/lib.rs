@@ -16,6 +16,7 @@ pub mod plot;
 pub mod profiling;
 pub mod scene;
 pub mod shaders;
+pub mod view;
 pub mod vk;
 
 pub use error::{Error, Result};

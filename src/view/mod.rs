@@ -1,0 +1,700 @@
+//! `translucent view`: the renderer's frames in a window, with an orbit camera, light and material
+//! edits from the mouse, the keys or a `--script`, scripted frame counts and screenshots.
+//!
+//! The frame is the same `Renderer::render_frame` as `render` and the tests; its tone-mapped image
+//! is copied into an image that the presenter blits to the window (src/vk/swapchain.rs).
+
+pub mod controls;
+
+use std::collections::VecDeque;
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use clap::Args;
+use glam::Vec3;
+use winit::application::ApplicationHandler;
+use winit::dpi::PhysicalSize;
+use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
+use winit::keyboard::{Key, ModifiersState, NamedKey};
+use winit::raw_window_handle::{HasDisplayHandle, HasWindowHandle};
+use winit::window::{Window, WindowId};
+
+use crate::cli::{self, RenderArgs, ShowArg};
+use crate::error::{Error, Result};
+use crate::frame::{FrameOptions, Renderer, Show, SubsurfaceOptions};
+use crate::hierarchy::HierarchyOptions;
+use crate::output::Exposure;
+use crate::scene::Scene;
+use crate::vk::{self, Context, Image, ImageUsageFlags, PresentMode, Presented, Presenter, TimedScope};
+use crate::{bad_input, runtime};
+use controls::{Action, ScriptLine, Setting};
+
+#[derive(Args, Debug)]
+pub struct ViewArgs {
+    #[command(flatten)]
+    pub render: RenderArgs,
+    /// How frames wait for the screen: fifo (vertical blank; always offered), fifo-relaxed,
+    /// mailbox, immediate.
+    #[arg(long, value_enum, default_value = "fifo")]
+    pub present_mode: PresentModeArg,
+    /// Write the last presented image (PNG) when the viewer exits.
+    #[arg(long, value_name = "FILE.png")]
+    pub screenshot: Option<PathBuf>,
+    /// Run the commands of this file, one per line (orbit, pan, zoom, light, material, set,
+    /// frames, screenshot, resize, pause, trace, quit; see README "View").
+    #[arg(long, value_name = "FILE")]
+    pub script: Option<PathBuf>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum PresentModeArg {
+    Fifo,
+    FifoRelaxed,
+    Mailbox,
+    Immediate,
+}
+
+impl From<PresentModeArg> for PresentMode {
+    fn from(m: PresentModeArg) -> PresentMode {
+        match m {
+            PresentModeArg::Fifo => PresentMode::Fifo,
+            PresentModeArg::FifoRelaxed => PresentMode::FifoRelaxed,
+            PresentModeArg::Mailbox => PresentMode::Mailbox,
+            PresentModeArg::Immediate => PresentMode::Immediate,
+        }
+    }
+}
+
+/// Whether the environment names a window system at all (X11 or Wayland).
+fn has_window_system() -> bool {
+    ["DISPLAY", "WAYLAND_DISPLAY", "WAYLAND_SOCKET"].iter().any(|v| std::env::var_os(v).is_some_and(|s| !s.is_empty()))
+}
+
+fn no_window_system(why: &str) -> Error {
+    bad_input!(
+        "view needs a window system ({why}); `translucent render` writes images without one (or run `xvfb-run -a translucent view …`)"
+    )
+}
+
+/// Whether `--frames` was given (its default of 1 is `render`'s; `view` runs until closed without it).
+fn frames_given() -> bool {
+    std::env::args_os().any(|a| {
+        let a = a.to_string_lossy();
+        a == "--frames" || a.starts_with("--frames=")
+    })
+}
+
+pub fn run(args: &ViewArgs) -> Result<i32> {
+    // Everything the user typed is checked before a window opens.
+    if let Some(p) = &args.screenshot {
+        controls::parse_line(&format!("screenshot {}", p.display())).map_err(|e| bad_input!("--screenshot {e}"))?;
+    }
+    let script = match &args.script {
+        Some(p) => controls::load_script(p)?,
+        None => Vec::new(),
+    };
+    if !(args.render.roughness > 0.0 && args.render.roughness <= 1.0) {
+        return Err(bad_input!("--roughness {}: must be in (0, 1]", args.render.roughness));
+    }
+    let scene = cli::build_scene(&args.render)?;
+    let material = args.render.material.material()?;
+    if !has_window_system() {
+        return Err(no_window_system("neither DISPLAY nor WAYLAND_DISPLAY is set"));
+    }
+    let event_loop = EventLoop::new().map_err(|e| no_window_system(&format!("cannot connect: {e}")))?;
+    let subsurface = SubsurfaceOptions {
+        material,
+        model: args.render.model.into(),
+        diffusion: args.render.diffusion.into(),
+        epsilon: args.render.epsilon,
+        brute_force: args.render.brute_force,
+        specular: !args.render.no_specular,
+        roughness: args.render.roughness,
+    };
+    let mut app = App {
+        args,
+        start: Some((scene, subsurface)),
+        viewer: None,
+        error: None,
+        validation: None,
+        script: script.into(),
+        frames_limit: frames_given().then_some(args.render.frames),
+    };
+    event_loop.run_app(&mut app).map_err(|e| runtime!("window event loop: {e}"))?;
+    let App { viewer, error, validation, .. } = app;
+    // Presenter before renderer (device) before window: see Viewer's field order.
+    drop(viewer);
+    if let Some(e) = error {
+        return Err(e);
+    }
+    Ok(match validation {
+        Some((validating, counts)) => cli::validation_exit_code(validating, &counts),
+        None => 0,
+    })
+}
+
+struct App<'a> {
+    args: &'a ViewArgs,
+    /// What the viewer is built from, taken when the window opens.
+    start: Option<(Scene, SubsurfaceOptions)>,
+    viewer: Option<Viewer>,
+    error: Option<Error>,
+    validation: Option<(bool, Arc<vk::ValidationCounts>)>,
+    script: VecDeque<ScriptLine>,
+    frames_limit: Option<u32>,
+}
+
+impl App<'_> {
+    fn fail(&mut self, event_loop: &ActiveEventLoop, e: Error) {
+        if self.error.is_none() {
+            self.error = Some(e);
+        }
+        event_loop.exit();
+    }
+}
+
+impl ApplicationHandler for App<'_> {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        let Some((scene, subsurface)) = self.start.take() else { return };
+        let script = std::mem::take(&mut self.script);
+        match Viewer::new(event_loop, self.args, scene, subsurface, script, self.frames_limit) {
+            Ok(viewer) => {
+                self.validation = Some((viewer.renderer.ctx.validation, viewer.renderer.ctx.validation_counts()));
+                self.viewer = Some(viewer);
+            }
+            Err(e) => self.fail(event_loop, e),
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        let Some(viewer) = self.viewer.as_mut() else { return };
+        let result = match event {
+            WindowEvent::CloseRequested => {
+                viewer.quit = true;
+                Ok(())
+            }
+            WindowEvent::Resized(size) => {
+                viewer.resized(size.width, size.height);
+                Ok(())
+            }
+            WindowEvent::RedrawRequested => viewer.step(),
+            WindowEvent::ModifiersChanged(m) => {
+                viewer.input.modifiers = m.state();
+                Ok(())
+            }
+            WindowEvent::MouseInput { state, button, .. } => {
+                viewer.input.buttons.retain(|b| *b != button);
+                if state == ElementState::Pressed {
+                    viewer.input.buttons.push(button);
+                }
+                Ok(())
+            }
+            WindowEvent::CursorMoved { position, .. } => {
+                viewer.cursor_moved(position.x, position.y);
+                Ok(())
+            }
+            WindowEvent::MouseWheel { delta, .. } => {
+                let notches = match delta {
+                    MouseScrollDelta::LineDelta(_, y) => y,
+                    MouseScrollDelta::PixelDelta(p) => p.y as f32 / 40.0,
+                };
+                viewer.interact(Action::Zoom(1.1f32.powf(notches)))
+            }
+            WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
+                viewer.key(&event.logical_key)
+            }
+            _ => Ok(()),
+        };
+        if let Err(e) = result {
+            self.fail(event_loop, e);
+        }
+    }
+
+    fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
+        let Some(viewer) = self.viewer.as_mut() else { return };
+        if viewer.quit {
+            if let Err(e) = viewer.finish() {
+                self.fail(event_loop, e);
+            }
+            event_loop.exit();
+            return;
+        }
+        if viewer.has_work() {
+            event_loop.set_control_flow(ControlFlow::Poll);
+            viewer.window.request_redraw();
+        } else if let Some((_, asked)) = viewer.pending_resize {
+            // Waiting for the window system to apply a scripted resize: look again shortly.
+            event_loop.set_control_flow(ControlFlow::WaitUntil(asked + RESIZE_WAIT.min(Duration::from_millis(20))));
+            if asked.elapsed() > RESIZE_WAIT {
+                viewer.window.request_redraw();
+            }
+        } else {
+            event_loop.set_control_flow(ControlFlow::Wait);
+        }
+    }
+}
+
+/// How long a scripted resize waits for the window system before going on with the size it has.
+const RESIZE_WAIT: Duration = Duration::from_secs(3);
+
+#[derive(Default)]
+struct Input {
+    buttons: Vec<MouseButton>,
+    modifiers: ModifiersState,
+    cursor: Option<(f64, f64)>,
+}
+
+/// Degrees of orbit per pixel dragged.
+const DEGREES_PER_PIXEL: f32 = 0.4;
+
+struct Viewer {
+    // Field order is drop order: the image and presenter (surface) before the renderer (which owns
+    // the device), the window last.
+    /// The tone-mapped image in the swapchain's 8-bit encoding, blitted to the window.
+    source: Option<Image>,
+    presenter: Presenter,
+    renderer: Renderer,
+    window: Arc<Window>,
+    scene: Scene,
+    subsurface: SubsurfaceOptions,
+    /// The object's centre: orbits turn about it, point lights too.
+    centre: Vec3,
+    /// The window's size in pixels (zero when minimised).
+    size: (u32, u32),
+    script: VecDeque<ScriptLine>,
+    /// Frames the current script line still waits for.
+    script_frames: u32,
+    /// A scripted resize not yet applied by the window system, and when it was asked for.
+    pending_resize: Option<((u32, u32), Instant)>,
+    /// Exit after this many presented frames (`--frames`).
+    frames_limit: Option<u32>,
+    presented: u32,
+    /// The scene changed since the last rendered frame.
+    dirty: bool,
+    /// A rendered frame has not reached the window yet (skipped present, or never shown).
+    unshown: bool,
+    quit: bool,
+    input: Input,
+    screenshot_at_exit: Option<PathBuf>,
+    /// Chrome trace being collected: frames still to take, the frames so far, the file.
+    trace: Option<(u32, Vec<Vec<TimedScope>>, PathBuf)>,
+    fps: FrameClock,
+    device_name: String,
+}
+
+/// Frame times for the title bar.
+struct FrameClock {
+    last: Option<Instant>,
+    seconds: f64,
+}
+
+impl Viewer {
+    fn new(
+        event_loop: &ActiveEventLoop,
+        args: &ViewArgs,
+        scene: Scene,
+        subsurface: SubsurfaceOptions,
+        script: VecDeque<ScriptLine>,
+        frames_limit: Option<u32>,
+    ) -> Result<Viewer> {
+        let r = &args.render;
+        let attributes = Window::default_attributes()
+            .with_title("translucent")
+            .with_inner_size(PhysicalSize::new(r.width, r.height));
+        let window =
+            Arc::new(event_loop.create_window(attributes).map_err(|e| no_window_system(&format!("no window: {e}")))?);
+        let display = event_loop.display_handle().map_err(|e| runtime!("display handle: {e}"))?.as_raw();
+        let ctx = Context::for_window(&r.device.options(), display)?;
+        let device_name = format!("{} ({})", ctx.info.name, ctx.info.driver);
+        let size = window.inner_size();
+        let handle = window.window_handle().map_err(|e| runtime!("window handle: {e}"))?.as_raw();
+        let presenter = Presenter::new(&ctx, display, handle, (size.width, size.height), args.present_mode.into())?;
+        log::info!("window {}x{}, swapchain format {:?}", size.width, size.height, presenter.surface_format());
+
+        let point_count = match r.samples {
+            Some(n) => {
+                crate::hierarchy::check_point_count(&ctx, n)?;
+                n
+            }
+            None => cli::default_point_count(&ctx, &scene, &subsurface.material),
+        };
+        let show = match r.show {
+            ShowArg::Shading => Show::Shading,
+            ShowArg::Samples => Show::Samples,
+            ShowArg::Tree => Show::Tree(r.level),
+        };
+        let eta = subsurface.material.eta as f32;
+        let options = FrameOptions {
+            subsurface: SubsurfaceOptions { material: subsurface.material.clone(), ..subsurface },
+            // The window's size: the renderer follows it from the first frame on.
+            width: size.width.max(1),
+            height: size.height.max(1),
+            profile: true,
+            count_work: r.profile,
+            hierarchy: HierarchyOptions { point_count, shadow_resolution: r.shadow_resolution, eta },
+            show,
+            exposure: r.exposure.map(Exposure::Stops).unwrap_or(Exposure::Auto),
+        };
+        let renderer = Renderer::new(ctx, &scene, options)?;
+        let (centre, _) = crate::scene::bounding_sphere(&scene.mesh.positions);
+        Ok(Viewer {
+            source: None,
+            presenter,
+            renderer,
+            window,
+            scene,
+            subsurface,
+            centre,
+            size: (size.width, size.height),
+            script,
+            script_frames: 0,
+            pending_resize: None,
+            frames_limit,
+            presented: 0,
+            dirty: true,
+            unshown: false,
+            quit: false,
+            input: Input::default(),
+            screenshot_at_exit: args.screenshot.clone(),
+            trace: None,
+            fps: FrameClock { last: None, seconds: 0.0 },
+            device_name,
+        })
+    }
+
+    /// Whether the loop should come round again without waiting for input.
+    fn has_work(&self) -> bool {
+        let script_waiting = self.pending_resize.is_some();
+        let limit_left = self.frames_limit.is_some_and(|n| self.presented < n);
+        self.dirty
+            || self.unshown
+            || self.script_frames > 0
+            || limit_left
+            || (!self.script.is_empty() && !script_waiting)
+            || self.trace.is_some()
+    }
+
+    fn minimised(&self) -> bool {
+        self.size.0 == 0 || self.size.1 == 0
+    }
+
+    /// The window's new size, from the window system or a scripted resize (zero: minimised).
+    fn resized(&mut self, width: u32, height: u32) {
+        if (width, height) != self.size {
+            self.size = (width, height);
+            self.presenter.resize(width, height);
+            if !self.minimised() {
+                self.dirty = true;
+            }
+        }
+        if self.pending_resize.is_some_and(|(want, _)| want == (width, height)) {
+            self.pending_resize = None;
+        }
+    }
+
+    fn cursor_moved(&mut self, x: f64, y: f64) {
+        let previous = self.input.cursor.replace((x, y));
+        let Some((px, py)) = previous else { return };
+        let (dx, dy) = ((x - px) as f32, (y - py) as f32);
+        let (b, m) = (&self.input.buttons, self.input.modifiers);
+        let action = if b.contains(&MouseButton::Left) && m.control_key() {
+            Action::TurnLights { right_deg: dx * DEGREES_PER_PIXEL, up_deg: -dy * DEGREES_PER_PIXEL }
+        } else if b.contains(&MouseButton::Middle)
+            || b.contains(&MouseButton::Right)
+            || (b.contains(&MouseButton::Left) && m.shift_key())
+        {
+            let h = self.size.1.max(1) as f32;
+            Action::Pan { right: -dx / h, up: dy / h }
+        } else if b.contains(&MouseButton::Left) {
+            Action::Orbit { right_deg: -dx * DEGREES_PER_PIXEL, up_deg: dy * DEGREES_PER_PIXEL }
+        } else {
+            return;
+        };
+        if let Err(e) = self.interact(action) {
+            log::error!("{e}");
+        }
+    }
+
+    fn key(&mut self, key: &Key) -> Result<()> {
+        let shift = self.input.modifiers.shift_key();
+        let step = 5.0;
+        let action = match key {
+            Key::Named(NamedKey::Escape) => Action::Quit,
+            Key::Named(NamedKey::ArrowLeft) if shift => Action::Pan { right: -0.05, up: 0.0 },
+            Key::Named(NamedKey::ArrowRight) if shift => Action::Pan { right: 0.05, up: 0.0 },
+            Key::Named(NamedKey::ArrowUp) if shift => Action::Pan { right: 0.0, up: 0.05 },
+            Key::Named(NamedKey::ArrowDown) if shift => Action::Pan { right: 0.0, up: -0.05 },
+            Key::Named(NamedKey::ArrowLeft) => Action::Orbit { right_deg: -step, up_deg: 0.0 },
+            Key::Named(NamedKey::ArrowRight) => Action::Orbit { right_deg: step, up_deg: 0.0 },
+            Key::Named(NamedKey::ArrowUp) => Action::Orbit { right_deg: 0.0, up_deg: step },
+            Key::Named(NamedKey::ArrowDown) => Action::Orbit { right_deg: 0.0, up_deg: -step },
+            Key::Named(NamedKey::Space) => Action::TogglePause,
+            Key::Character(c) => match c.as_str() {
+                "q" => Action::Quit,
+                "+" | "=" => Action::Zoom(1.1),
+                "-" => Action::Zoom(1.0 / 1.1),
+                "j" => Action::TurnLights { right_deg: -step, up_deg: 0.0 },
+                "l" => Action::TurnLights { right_deg: step, up_deg: 0.0 },
+                "i" => Action::TurnLights { right_deg: 0.0, up_deg: step },
+                "k" => Action::TurnLights { right_deg: 0.0, up_deg: -step },
+                "p" => Action::Screenshot(next_free_path("translucent-view", "png")),
+                "t" => Action::Trace(10, next_free_path("translucent-trace", "json")),
+                _ => return Ok(()),
+            },
+            _ => return Ok(()),
+        };
+        self.interact(action)
+    }
+
+    /// An action from the mouse or the keys.
+    fn interact(&mut self, action: Action) -> Result<()> {
+        self.apply(action)
+    }
+
+    /// Applies one action: the one path for scripts, keys and the mouse.
+    fn apply(&mut self, action: Action) -> Result<()> {
+        match action {
+            Action::Orbit { right_deg, up_deg } => {
+                controls::orbit(&mut self.scene.camera, right_deg, up_deg);
+                self.dirty = true;
+            }
+            Action::Pan { right, up } => {
+                controls::pan(&mut self.scene.camera, right, up);
+                self.dirty = true;
+            }
+            Action::Zoom(f) => {
+                controls::zoom(&mut self.scene.camera, f);
+                self.dirty = true;
+            }
+            Action::TurnLights { right_deg, up_deg } => {
+                controls::turn_lights(&mut self.scene.lights, &self.scene.camera, self.centre, right_deg, up_deg);
+                self.dirty = true;
+            }
+            Action::SetLight(light) => {
+                self.scene.lights[0] = light;
+                self.dirty = true;
+            }
+            Action::Material(name) => {
+                self.subsurface.material = crate::materials::Material::find(&name)?;
+                self.update_subsurface()?;
+            }
+            Action::Set(setting) => {
+                let s = &mut self.subsurface;
+                match setting {
+                    Setting::Epsilon(e) => s.epsilon = e,
+                    Setting::Exposure(stops) => {
+                        self.renderer.set_exposure(stops.map(Exposure::Stops).unwrap_or(Exposure::Auto))
+                    }
+                    Setting::Specular(on) => s.specular = on,
+                    Setting::Roughness(r) => s.roughness = r,
+                    Setting::Model(m) => s.model = m,
+                    Setting::BruteForce(on) => s.brute_force = on,
+                    Setting::SigmaA(v) => s.material.sigma_a = v,
+                    Setting::SigmaS(v) => s.material.sigma_s = v,
+                    Setting::G(v) => s.material.g = v,
+                }
+                self.subsurface.material.validate()?;
+                self.update_subsurface()?;
+            }
+            Action::Frames(n) => self.script_frames = n,
+            Action::Screenshot(path) => {
+                self.refine_now()?;
+                self.renderer.write_image(&path)?;
+                eprintln!("wrote {}", path.display());
+            }
+            Action::Resize(0, 0) => {
+                // Not every window system can minimise (X without a window manager cannot), so
+                // the zero size goes through the same path as the window system's own event.
+                self.window.set_minimized(true);
+                self.resized(0, 0);
+            }
+            Action::Resize(w, h) => {
+                if self.minimised() {
+                    self.window.set_minimized(false);
+                }
+                let now = self.window.inner_size();
+                if (now.width, now.height) == (w, h) {
+                    self.resized(w, h);
+                } else {
+                    self.pending_resize = Some(((w, h), Instant::now()));
+                    if let Some(applied) = self.window.request_inner_size(PhysicalSize::new(w, h)) {
+                        self.resized(applied.width, applied.height);
+                    }
+                }
+            }
+            Action::TogglePause => {}
+            Action::Trace(frames, path) => {
+                self.trace = Some((frames, Vec::new(), path));
+                self.dirty = true;
+            }
+            Action::Quit => self.quit = true,
+        }
+        Ok(())
+    }
+
+    fn update_subsurface(&mut self) -> Result<()> {
+        self.renderer.set_subsurface(&self.subsurface, self.scene.mm_per_unit)?;
+        self.dirty = true;
+        Ok(())
+    }
+
+    /// Makes sure that the last rendered frame shows the current scene at the window's size.
+    fn refine_now(&mut self) -> Result<()> {
+        if self.dirty || self.source.is_none() {
+            self.render_and_present()?;
+        }
+        Ok(())
+    }
+
+    /// Runs script lines until one has to wait (for frames or a resize).
+    fn run_script(&mut self) -> Result<()> {
+        if let Some((want, asked)) = self.pending_resize {
+            if asked.elapsed() < RESIZE_WAIT {
+                return Ok(());
+            }
+            let now = self.window.inner_size();
+            log::warn!("resize {}x{}: the window system gave {}x{}", want.0, want.1, now.width, now.height);
+            self.pending_resize = None;
+            self.resized(now.width, now.height);
+        }
+        while self.script_frames == 0 && self.pending_resize.is_none() && !self.quit {
+            let Some(line) = self.script.pop_front() else { break };
+            log::info!("script line {}: {}", line.number, line.text);
+            self.apply(line.action).map_err(|e| match e {
+                Error::BadInput(m) => bad_input!("--script line {} (`{}`): {m}", line.number, line.text),
+                Error::Runtime(m) => runtime!("--script line {} (`{}`): {m}", line.number, line.text),
+            })?;
+        }
+        Ok(())
+    }
+
+    /// One turn of the loop: script lines, then a frame if anything asks for one.
+    fn step(&mut self) -> Result<()> {
+        self.run_script()?;
+        if self.quit {
+            return Ok(());
+        }
+        if self.minimised() {
+            // Nothing to show; a scripted frame count still runs down so the script goes on.
+            self.script_frames = self.script_frames.saturating_sub(1);
+            return Ok(());
+        }
+        let limit_left = self.frames_limit.is_some_and(|n| self.presented < n);
+        if self.dirty || self.script_frames > 0 || limit_left || self.trace.is_some() {
+            self.render_and_present()?;
+        } else if self.unshown || self.source.is_some() {
+            // Exposed or skipped: show the last frame again without rendering it again.
+            self.present()?;
+        }
+        if self.frames_limit.is_some_and(|n| self.presented >= n) {
+            self.quit = true;
+        }
+        Ok(())
+    }
+
+    fn render_and_present(&mut self) -> Result<()> {
+        let (w, h) = self.size;
+        if w == 0 || h == 0 {
+            return Ok(());
+        }
+        self.renderer.set_size(w, h)?;
+        let scopes = self.renderer.render_frame(&self.scene)?;
+        self.dirty = false;
+        self.unshown = true;
+        if let Some((left, frames, path)) = self.trace.as_mut() {
+            frames.push(scopes.clone());
+            *left -= 1;
+            if *left == 0 {
+                let report = Self::report(&self.device_name, std::mem::take(frames));
+                std::fs::write(&*path, crate::profiling::chrome_trace_json(&report))
+                    .map_err(|e| runtime!("trace {}: {e}", path.display()))?;
+                eprintln!("wrote {} ({} frames)", path.display(), report.frames.len());
+                self.trace = None;
+            }
+        }
+        let gpu_ms: f64 =
+            scopes.iter().filter(|s| !s.name.contains('/')).map(|s| s.end_ns - s.begin_ns).sum::<f64>() / 1e6;
+        let now = Instant::now();
+        if let Some(last) = self.fps.last.replace(now) {
+            self.fps.seconds = (now - last).as_secs_f64();
+        }
+        self.window.set_title(&format!(
+            "translucent — {} — {}x{} — frame {:.0} ms ({:.1} fps), GPU {:.0} ms",
+            self.device_name,
+            w,
+            h,
+            self.fps.seconds * 1e3,
+            if self.fps.seconds > 0.0 { 1.0 / self.fps.seconds } else { 0.0 },
+            gpu_ms
+        ));
+        self.present()
+    }
+
+    fn report(device_name: &str, frames: Vec<Vec<TimedScope>>) -> crate::profiling::ProfileReport {
+        use crate::profiling::{ProfileReport, Scope};
+        ProfileReport {
+            device: device_name.to_string(),
+            frames: frames
+                .into_iter()
+                .map(|f| {
+                    f.into_iter().map(|s| Scope { name: s.name, begin_ns: s.begin_ns, end_ns: s.end_ns }).collect()
+                })
+                .collect(),
+        }
+    }
+
+    /// Copies the last rendered frame into the window's image and shows it.
+    fn present(&mut self) -> Result<()> {
+        let extent = self.renderer.extent();
+        let format = self.presenter.source_format();
+        if self.source.as_ref().is_none_or(|s| s.extent != extent) {
+            // The previous image may still be read by a present in flight.
+            self.renderer.ctx.wait_idle()?;
+            self.source = Some(Image::new_2d(
+                &self.renderer.ctx,
+                "window image",
+                format,
+                extent,
+                1,
+                // SAMPLED only because every Image has a view, which needs a usage views allow.
+                ImageUsageFlags::TRANSFER_DST | ImageUsageFlags::TRANSFER_SRC | ImageUsageFlags::SAMPLED,
+            )?);
+        }
+        let source = self.source.as_ref().expect("made above");
+        let ldr = self.renderer.tone_mapped_buffer();
+        let shown = self.presenter.present(&self.renderer.ctx, source, |rec| rec.copy_buffer_to_image(ldr, source))?;
+        if shown == Presented::Shown {
+            self.unshown = false;
+            self.presented += 1;
+            self.script_frames = self.script_frames.saturating_sub(1);
+        }
+        Ok(())
+    }
+
+    /// At exit: the `--screenshot`.
+    fn finish(&mut self) -> Result<()> {
+        if let Some(path) = self.screenshot_at_exit.take() {
+            self.refine_now()?;
+            self.renderer.write_image(&path)?;
+            eprintln!("wrote {}", path.display());
+        }
+        Ok(())
+    }
+}
+
+impl Drop for Viewer {
+    fn drop(&mut self) {
+        // The window image goes first, and a present may still be reading it.
+        let _ = self.renderer.ctx.wait_idle();
+    }
+}
+
+/// `stem-0000.ext`, the first number not taken in the working folder.
+fn next_free_path(stem: &str, ext: &str) -> PathBuf {
+    (0..10000)
+        .map(|i| PathBuf::from(format!("{stem}-{i:04}.{ext}")))
+        .find(|p| !p.exists())
+        .unwrap_or_else(|| PathBuf::from(format!("{stem}.{ext}")))
+}
