@@ -17,20 +17,21 @@ use crate::vk::{
 };
 
 /// Shading units for the next submission after `batch` units took `seconds`: as many as fit in
-/// SUBMISSION_TARGET_S at that pace, growing at most ×2 per step, within [1, MAX_UNITS_PER_SUBMISSION].
-fn next_batch_size(batch: usize, seconds: f64) -> usize {
+/// `target` seconds (SUBMISSION_TARGET_S unless set) at that pace, growing at most ×2 per step,
+/// within [1, MAX_UNITS_PER_SUBMISSION].
+fn next_batch_size(batch: usize, seconds: f64, target: f64) -> usize {
     let per_unit = seconds / batch.max(1) as f64;
-    let fit = (SUBMISSION_TARGET_S / per_unit.max(1e-9)).floor() as usize;
+    let fit = (target / per_unit.max(1e-9)).floor() as usize;
     fit.clamp(1, (2 * batch).clamp(1, MAX_UNITS_PER_SUBMISSION))
 }
 
 /// Whether the next frame shades the whole image as one tile: once a frame's shading took one
-/// submission of under a quarter of SUBMISSION_TARGET_S, and for as long as it stays under the target.
-fn shade_whole_frame(whole_frame: bool, submissions: usize, seconds: f64) -> bool {
+/// submission of under a quarter of the `target` time, and for as long as it stays under the target.
+fn shade_whole_frame(whole_frame: bool, submissions: usize, seconds: f64, target: f64) -> bool {
     if whole_frame {
-        seconds < SUBMISSION_TARGET_S
+        seconds < target
     } else {
-        submissions == 1 && seconds < SUBMISSION_TARGET_S / 4.0
+        submissions == 1 && seconds < target / 4.0
     }
 }
 
@@ -51,6 +52,52 @@ fn subsurface_params(o: &SubsurfaceOptions, mm_per_unit: f32, point_count: u32) 
         specular: o.specular as u32,
         roughness: o.roughness,
         pad: [0; 3],
+    }
+}
+
+/// The shading inputs, borrowed field by field (a method would borrow all of `self`, and the
+/// profiler is borrowed mutably beside them).
+macro_rules! shade_inputs {
+    ($r:expr) => {
+        ShadeInputs {
+            color: &$r.color,
+            depth: &$r.depth,
+            vertices: &$r.vertices,
+            indices: &$r.indices,
+            index_count: $r.index_count,
+            params: &$r.subsurface_params,
+            nodes: &$r.hierarchy.nodes,
+            points: &$r.hierarchy.sorted_points,
+            work: &$r.work_counters,
+            lights: &$r.hierarchy.lights,
+            shadow_map: &$r.hierarchy.shadow_map,
+            shadow_sampler: &$r.hierarchy.shadow_sampler,
+        }
+    };
+}
+
+/// A frame between [`Renderer::begin_frame`] and [`Renderer::finish_frame`].
+pub struct FrameInProgress {
+    view_projection: glam::Mat4,
+    constants: ShadeConstants,
+    units: Vec<shade::ShadeUnit>,
+    done: usize,
+    submissions: usize,
+    shading_seconds: f64,
+    /// The longest time a submission took per unit in it.
+    longest_unit_seconds: f64,
+    extent: Extent2D,
+}
+
+impl FrameInProgress {
+    /// The fraction of the shading done, 0 to 1.
+    pub fn progress(&self) -> f32 {
+        self.done as f32 / self.units.len().max(1) as f32
+    }
+
+    /// The longest time one shading unit (tile) took so far, as measured per submission.
+    pub fn longest_unit_seconds(&self) -> f64 {
+        self.longest_unit_seconds
     }
 }
 
@@ -127,8 +174,10 @@ pub struct Renderer {
     tile_fixed: bool,
     /// Frames rendered, for the progress bar.
     frames_done: u64,
-    /// Shading units per submission, adapted to SUBMISSION_TARGET_S.
+    /// Shading units per submission, adapted to `submission_target_s`.
     units_per_submission: usize,
+    /// How long one shading submission should take (SUBMISSION_TARGET_S unless set).
+    submission_target_s: f64,
     /// Advanced by one per shading unit done, when set (the CLI sets one on a terminal).
     pub progress: Option<indicatif::ProgressBar>,
     debug_view: DebugViewPass,
@@ -230,6 +279,7 @@ impl Renderer {
             tile_fixed: false,
             frames_done: 0,
             units_per_submission: 1,
+            submission_target_s: SUBMISSION_TARGET_S,
             progress: None,
             debug_view: DebugViewPass::new(&ctx)?,
             show,
@@ -270,6 +320,12 @@ impl Renderer {
             self.units_per_submission = 1;
         }
         Ok(())
+    }
+
+    /// How long one shading submission should take from now on (a window wants short ones to stay
+    /// responsive; the default suits GPU watchdogs and the progress bar).
+    pub fn set_submission_target(&mut self, seconds: f64) {
+        self.submission_target_s = seconds.max(1e-3);
     }
 
     /// The size of the images rendered.
@@ -320,6 +376,11 @@ impl Renderer {
         self.whole_frame = false;
     }
 
+    /// The side of the shading tiles in pixels (when not shading whole frames).
+    pub fn tile_size(&self) -> u32 {
+        self.tile
+    }
+
     /// The progress bar's length for `frames` frames (it counts thousandths of a frame).
     pub fn progress_length(frames: u32) -> u64 {
         frames as u64 * 1000
@@ -328,6 +389,16 @@ impl Renderer {
     /// Renders one frame and returns its GPU timestamp scopes (empty without a profiler). The
     /// lights are taken from `scene` every frame, so they may move between frames.
     pub fn render_frame(&mut self, scene: &Scene) -> Result<Vec<TimedScope>> {
+        let mut frame = self.begin_frame(scene)?;
+        while !self.shade_some(&mut frame, None)? {}
+        self.finish_frame(frame)
+    }
+
+    /// The first part of [`render_frame`](Self::render_frame): the hierarchy and the depth
+    /// pre-pass. Shading follows in [`shade_some`](Self::shade_some) steps (a window spreads them
+    /// over turns of its event loop), then [`finish_frame`](Self::finish_frame). A frame may be
+    /// dropped unfinished; every submission has completed when these return.
+    pub fn begin_frame(&mut self, scene: &Scene) -> Result<FrameInProgress> {
         let aspect = self.extent.width as f32 / self.extent.height as f32;
         let view_projection = scene.camera.view_projection(aspect, self.bounds);
         let constants =
@@ -336,20 +407,7 @@ impl Renderer {
             self.hierarchy.set_lights(&scene.mesh, &scene.lights)?;
             self.lights = scene.lights.clone();
         }
-        let inputs = ShadeInputs {
-            color: &self.color,
-            depth: &self.depth,
-            vertices: &self.vertices,
-            indices: &self.indices,
-            index_count: self.index_count,
-            params: &self.subsurface_params,
-            nodes: &self.hierarchy.nodes,
-            points: &self.hierarchy.sorted_points,
-            work: &self.work_counters,
-            lights: &self.hierarchy.lights,
-            shadow_map: &self.hierarchy.shadow_map,
-            shadow_sampler: &self.hierarchy.shadow_sampler,
-        };
+        let inputs = shade_inputs!(self);
 
         // The frame, in order: the hierarchy (sampling, shadow maps, irradiance, Morton codes,
         // sort, tree build, summaries; each its own scope), the depth pre-pass, shading in
@@ -364,14 +422,43 @@ impl Renderer {
             rec.end_scope();
             Ok(())
         })?;
+        Ok(FrameInProgress {
+            view_projection,
+            constants,
+            units: self.units(),
+            done: 0,
+            submissions: 0,
+            shading_seconds: 0.0,
+            longest_unit_seconds: 0.0,
+            extent: self.extent,
+        })
+    }
 
+    /// Shading submissions until the frame is shaded, or with a `budget`, until the next one
+    /// would likely overrun it (at least one is made). Returns whether the shading is complete.
+    pub fn shade_some(&mut self, frame: &mut FrameInProgress, budget: Option<std::time::Duration>) -> Result<bool> {
+        if frame.extent != self.extent {
+            return Err(crate::runtime!("a frame begun at one size was continued at another"));
+        }
+        let inputs = shade_inputs!(self);
+        let constants = frame.constants;
+        let started = std::time::Instant::now();
         // Shading in several submissions, so that none runs long (see SUBMISSION_TARGET_S).
-        let units = self.units();
-        let mut done = 0;
-        let (mut submissions, mut shading_seconds) = (0, 0.0);
-        while done < units.len() {
-            let batch = &units[done..(done + self.units_per_submission).min(units.len())];
-            let started = std::time::Instant::now();
+        let units = &frame.units;
+        while frame.done < units.len() {
+            let spent = started.elapsed().as_secs_f64();
+            if budget.is_some_and(|b| spent > 0.0 && spent + self.submission_target_s > b.as_secs_f64()) {
+                break;
+            }
+            let mut size = self.units_per_submission;
+            if let Some(b) = budget {
+                // Tiles differ in cost (background ones are cheap): with a budget, no more than
+                // the rest of it fits at the slowest pace seen in this frame.
+                let worst = frame.longest_unit_seconds.max(1e-9);
+                size = size.min((((b.as_secs_f64() - spent) / worst).floor() as usize).max(1));
+            }
+            let batch = &units[frame.done..(frame.done + size).min(units.len())];
+            let submitted = std::time::Instant::now();
             self.ctx.submit(self.profiler.as_mut(), |rec| {
                 rec.begin_scope("shade");
                 for unit in batch {
@@ -380,17 +467,29 @@ impl Renderer {
                 rec.end_scope();
                 Ok(())
             })?;
-            let seconds = started.elapsed().as_secs_f64();
-            done += batch.len();
-            (submissions, shading_seconds) = (submissions + 1, shading_seconds + seconds);
+            let seconds = submitted.elapsed().as_secs_f64();
+            frame.done += batch.len();
+            frame.longest_unit_seconds = frame.longest_unit_seconds.max(seconds / batch.len() as f64);
+            (frame.submissions, frame.shading_seconds) = (frame.submissions + 1, frame.shading_seconds + seconds);
             if let Some(bar) = &self.progress {
-                bar.set_position(self.frames_done * 1000 + (1000 * done / units.len()) as u64);
+                bar.set_position(self.frames_done * 1000 + (1000 * frame.done / units.len()) as u64);
             }
-            self.units_per_submission = next_batch_size(batch.len(), seconds);
+            self.units_per_submission = next_batch_size(batch.len(), seconds, self.submission_target_s);
         }
+        Ok(frame.done == units.len())
+    }
+
+    /// The last part of a frame: debug views, tone mapping and read-back. Returns the frame's GPU
+    /// timestamp scopes (empty without a profiler).
+    pub fn finish_frame(&mut self, frame: FrameInProgress) -> Result<Vec<TimedScope>> {
+        if frame.done < frame.units.len() || frame.extent != self.extent {
+            return Err(crate::runtime!("finish_frame: the frame's shading is not complete"));
+        }
+        let view_projection = frame.view_projection;
         self.frames_done += 1;
         if !self.tile_fixed {
-            self.whole_frame = shade_whole_frame(self.whole_frame, submissions, shading_seconds);
+            self.whole_frame =
+                shade_whole_frame(self.whole_frame, frame.submissions, frame.shading_seconds, self.submission_target_s);
         }
 
         if self.show == Show::Samples {
@@ -507,20 +606,24 @@ mod tests {
 
     #[test]
     fn submissions_grow_and_shrink_toward_the_target_time() {
-        assert_eq!(next_batch_size(1, 1e-6), 2, "fast: at most doubles");
-        assert_eq!(next_batch_size(200, 1e-6), MAX_UNITS_PER_SUBMISSION, "never past the descriptor pool");
-        assert_eq!(next_batch_size(8, 0.1), 16);
-        assert_eq!(next_batch_size(8, 0.8), 2, "slow: shrinks to what fits");
-        assert_eq!(next_batch_size(1, 30.0), 1, "never below one unit");
-        assert_eq!(next_batch_size(4, 0.0), 8);
+        assert_eq!(next_batch_size(1, 1e-6, SUBMISSION_TARGET_S), 2, "fast: at most doubles");
+        assert_eq!(
+            next_batch_size(200, 1e-6, SUBMISSION_TARGET_S),
+            MAX_UNITS_PER_SUBMISSION,
+            "never past the descriptor pool"
+        );
+        assert_eq!(next_batch_size(8, 0.1, SUBMISSION_TARGET_S), 16);
+        assert_eq!(next_batch_size(8, 0.8, SUBMISSION_TARGET_S), 2, "slow: shrinks to what fits");
+        assert_eq!(next_batch_size(1, 30.0, SUBMISSION_TARGET_S), 1, "never below one unit");
+        assert_eq!(next_batch_size(4, 0.0, SUBMISSION_TARGET_S), 8);
     }
 
     #[test]
     fn fast_frames_are_shaded_whole() {
-        assert!(shade_whole_frame(false, 1, 0.01), "one quick submission: one tile next time");
-        assert!(!shade_whole_frame(false, 2, 0.01), "several submissions: keep the tiles");
-        assert!(!shade_whole_frame(false, 1, 0.1), "not quick enough to risk a whole frame");
-        assert!(shade_whole_frame(true, 1, 0.15), "stays whole while under the target");
-        assert!(!shade_whole_frame(true, 1, 0.5), "back to tiles when a frame gets slow");
+        assert!(shade_whole_frame(false, 1, 0.01, SUBMISSION_TARGET_S), "one quick submission: one tile next time");
+        assert!(!shade_whole_frame(false, 2, 0.01, SUBMISSION_TARGET_S), "several submissions: keep the tiles");
+        assert!(!shade_whole_frame(false, 1, 0.1, SUBMISSION_TARGET_S), "not quick enough to risk a whole frame");
+        assert!(shade_whole_frame(true, 1, 0.15, SUBMISSION_TARGET_S), "stays whole while under the target");
+        assert!(!shade_whole_frame(true, 1, 0.5, SUBMISSION_TARGET_S), "back to tiles when a frame gets slow");
     }
 }

@@ -256,18 +256,18 @@ fn camera_axes(camera: &Camera) -> (Vec3, Vec3) {
     (right, right.cross(forward))
 }
 
-/// Turns the eye about the target (see [`Action::Orbit`]). Never past the poles: a vertical turn
-/// that would bring the view within 1° of the up axis is left out.
+/// Turns the eye about the target (see [`Action::Orbit`]). Never over the poles: the elevation
+/// stops 1° short of the up axis.
 pub fn orbit(camera: &mut Camera, right_deg: f32, up_deg: f32) {
     let up = camera.up.normalize();
     let offset = camera.eye - camera.target;
     // Positive: the camera moves to its right, so the object seems to turn left.
     let offset = Quat::from_axis_angle(up, right_deg.to_radians()) * offset;
     let (right, _) = camera_axes(&Camera { eye: camera.target + offset, ..*camera });
-    let lifted = Quat::from_axis_angle(right, up_deg.to_radians()) * offset;
-    let polar = lifted.normalize().dot(up).clamp(-1.0, 1.0).acos().to_degrees();
-    let offset = if (1.0..=179.0).contains(&polar) { lifted } else { offset };
-    camera.eye = camera.target + offset;
+    let elevation = 90.0 - offset.normalize().dot(up).clamp(-1.0, 1.0).acos().to_degrees();
+    let turn = (elevation + up_deg).clamp(-89.0, 89.0) - elevation;
+    // About `right` (forward × up), a negative angle lifts the eye.
+    camera.eye = camera.target + Quat::from_axis_angle(right, -turn.to_radians()) * offset;
 }
 
 pub fn pan(camera: &mut Camera, right: f32, up: f32) {
@@ -322,9 +322,9 @@ mod tests {
     fn orbit_stops_short_of_the_poles() {
         let mut c = camera();
         orbit(&mut c, 0.0, 95.0);
-        assert_eq!(c.eye, camera().eye, "past the pole: the vertical turn is left out");
-        orbit(&mut c, 0.0, 88.0);
-        assert!(c.eye.y > 4.9);
+        assert!(c.eye.z > 0.0 && c.eye.y > 4.99, "stops at 89°, on the near side: {}", c.eye);
+        orbit(&mut c, 0.0, -200.0);
+        assert!(c.eye.z > 0.0 && c.eye.y < -4.99, "and at -89°: {}", c.eye);
     }
 
     #[test]

@@ -23,7 +23,7 @@ use winit::window::{Window, WindowId};
 
 use crate::cli::{self, RenderArgs, ShowArg};
 use crate::error::{Error, Result};
-use crate::frame::{FrameOptions, Renderer, Show, SubsurfaceOptions};
+use crate::frame::{FrameInProgress, FrameOptions, Renderer, Show, SubsurfaceOptions};
 use crate::hierarchy::HierarchyOptions;
 use crate::output::Exposure;
 use crate::scene::Scene;
@@ -179,7 +179,13 @@ impl ApplicationHandler for App<'_> {
                 viewer.resized(size.width, size.height);
                 Ok(())
             }
-            WindowEvent::RedrawRequested => viewer.step(),
+            WindowEvent::RedrawRequested => {
+                let started = Instant::now();
+                let result = viewer.step();
+                viewer.longest_turn = viewer.longest_turn.max(started.elapsed());
+                viewer.longest_turn_of_frame = viewer.longest_turn_of_frame.max(started.elapsed());
+                result
+            }
             WindowEvent::ModifiersChanged(m) => {
                 viewer.input.modifiers = m.state();
                 Ok(())
@@ -221,20 +227,58 @@ impl ApplicationHandler for App<'_> {
             event_loop.exit();
             return;
         }
-        if viewer.has_work() {
-            event_loop.set_control_flow(ControlFlow::Poll);
-            viewer.window.request_redraw();
-        } else if let Some((_, asked)) = viewer.pending_resize {
-            // Waiting for the window system to apply a scripted resize: look again shortly.
-            event_loop.set_control_flow(ControlFlow::WaitUntil(asked + RESIZE_WAIT.min(Duration::from_millis(20))));
-            if asked.elapsed() > RESIZE_WAIT {
+        match viewer.next_turn() {
+            Turn::Now => {
+                event_loop.set_control_flow(ControlFlow::Poll);
                 viewer.window.request_redraw();
             }
-        } else {
-            event_loop.set_control_flow(ControlFlow::Wait);
+            Turn::At(when) => event_loop.set_control_flow(ControlFlow::WaitUntil(when)),
+            Turn::OnInput => event_loop.set_control_flow(ControlFlow::Wait),
         }
     }
 }
+
+/// When the event loop should come round to the viewer again.
+enum Turn {
+    Now,
+    At(Instant),
+    OnInput,
+}
+
+/// Input this recent counts as an ongoing interaction: frames are previews until it is older.
+const INTERACTION_HOLD: Duration = Duration::from_millis(300);
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum FrameKind {
+    /// At a fraction of the window's size, while the user interacts.
+    Preview,
+    Full,
+}
+
+impl FrameKind {
+    fn name(self) -> &'static str {
+        match self {
+            FrameKind::Preview => "preview",
+            FrameKind::Full => "refined",
+        }
+    }
+}
+
+/// Previews aim at this wall time (their size adapts).
+const PREVIEW_TARGET: Duration = Duration::from_millis(250);
+
+/// Full frames faster than this need no previews.
+const FAST_FRAME_S: f64 = 0.05;
+
+/// Tiles are halved while one takes longer than STEP_BUDGET, down to this side.
+const MIN_TILE: u32 = 16;
+
+/// Shading work per turn of the event loop while a frame is refined, so that input is handled
+/// about every 100 ms even when a full frame takes seconds (lavapipe).
+const STEP_BUDGET: Duration = Duration::from_millis(80);
+
+/// The renderer's shading submissions in the window: short, to fit STEP_BUDGET.
+const SUBMISSION_TARGET_S: f64 = 0.04;
 
 /// How long a scripted resize waits for the window system before going on with the size it has.
 const RESIZE_WAIT: Duration = Duration::from_secs(3);
@@ -282,6 +326,19 @@ struct Viewer {
     trace: Option<(u32, Vec<Vec<TimedScope>>, PathBuf)>,
     fps: FrameClock,
     device_name: String,
+    /// The frame being shaded over turns of the loop, what it is, and when it was begun.
+    frame: Option<(FrameInProgress, FrameKind, Instant)>,
+    /// Previews are the window's size divided by this (adapted to PREVIEW_TARGET).
+    preview_divisor: u32,
+    /// Wall time of the last full frame.
+    last_full_frame_s: Option<f64>,
+    /// The last frame shown was a preview: refine once the interaction stops.
+    shown_preview: bool,
+    last_interaction: Option<Instant>,
+    /// The longest turn of the event loop spent in the viewer (reported at exit).
+    longest_turn: Duration,
+    /// The same since the last frame was shown.
+    longest_turn_of_frame: Duration,
 }
 
 /// Frame times for the title bar.
@@ -337,7 +394,13 @@ impl Viewer {
             show,
             exposure: r.exposure.map(Exposure::Stops).unwrap_or(Exposure::Auto),
         };
-        let renderer = Renderer::new(ctx, &scene, options)?;
+        let mut renderer = Renderer::new(ctx, &scene, options)?;
+        renderer.set_submission_target(SUBMISSION_TARGET_S);
+        if renderer.ctx.info.device_type == ash::vk::PhysicalDeviceType::CPU {
+            // A CPU device (lavapipe) takes seconds per frame: tiles small enough for a turn of
+            // the event loop from the first frame on (they adapt further, see MIN_TILE).
+            renderer.set_tile_size(MIN_TILE);
+        }
         let (centre, _) = crate::scene::bounding_sphere(&scene.mesh.positions);
         Ok(Viewer {
             source: None,
@@ -361,19 +424,47 @@ impl Viewer {
             trace: None,
             fps: FrameClock { last: None, seconds: 0.0 },
             device_name,
+            frame: None,
+            preview_divisor: 4,
+            last_full_frame_s: None,
+            shown_preview: false,
+            last_interaction: None,
+            longest_turn: Duration::ZERO,
+            longest_turn_of_frame: Duration::ZERO,
         })
     }
 
-    /// Whether the loop should come round again without waiting for input.
-    fn has_work(&self) -> bool {
-        let script_waiting = self.pending_resize.is_some();
+    fn interacting(&self) -> bool {
+        self.last_interaction.is_some_and(|t| t.elapsed() < INTERACTION_HOLD)
+    }
+
+    /// Whether a new frame is asked for (not counting the refinement of a preview).
+    fn new_frame_wanted(&self) -> bool {
         let limit_left = self.frames_limit.is_some_and(|n| self.presented < n);
-        self.dirty
-            || self.unshown
-            || self.script_frames > 0
-            || limit_left
-            || (!self.script.is_empty() && !script_waiting)
-            || self.trace.is_some()
+        self.dirty || self.script_frames > 0 || limit_left || self.trace.is_some()
+    }
+
+    /// When the loop should come round again.
+    fn next_turn(&self) -> Turn {
+        if let Some((_, asked)) = self.pending_resize {
+            // Waiting for the window system to apply a scripted resize: look again shortly.
+            return if asked.elapsed() > RESIZE_WAIT {
+                Turn::Now
+            } else {
+                Turn::At(Instant::now() + Duration::from_millis(20))
+            };
+        }
+        if self.minimised() {
+            return if self.script_frames > 0 || !self.script.is_empty() { Turn::Now } else { Turn::OnInput };
+        }
+        if self.new_frame_wanted() || self.frame.is_some() || self.unshown || !self.script.is_empty() {
+            return Turn::Now;
+        }
+        match (self.shown_preview, self.last_interaction) {
+            (true, Some(t)) if self.interacting() => Turn::At(t + INTERACTION_HOLD),
+            (true, _) => Turn::Now,
+            _ => Turn::OnInput,
+        }
     }
 
     fn minimised(&self) -> bool {
@@ -448,8 +539,9 @@ impl Viewer {
         self.interact(action)
     }
 
-    /// An action from the mouse or the keys.
+    /// An action from the mouse or the keys: frames are previews while these keep coming.
     fn interact(&mut self, action: Action) -> Result<()> {
+        self.last_interaction = Some(Instant::now());
         self.apply(action)
     }
 
@@ -540,10 +632,16 @@ impl Viewer {
         Ok(())
     }
 
-    /// Makes sure that the last rendered frame shows the current scene at the window's size.
+    /// Makes sure that the last frame shown is the current scene at the window's size.
     fn refine_now(&mut self) -> Result<()> {
-        if self.dirty || self.source.is_none() {
-            self.render_and_present()?;
+        if self.dirty || matches!(self.frame, Some((_, FrameKind::Preview, _))) {
+            self.frame = None;
+        }
+        if self.frame.is_none() && (self.dirty || self.shown_preview || self.source.is_none()) {
+            self.begin(FrameKind::Full)?;
+        }
+        if self.frame.is_some() {
+            self.shade(None)?;
         }
         Ok(())
     }
@@ -570,7 +668,8 @@ impl Viewer {
         Ok(())
     }
 
-    /// One turn of the loop: script lines, then a frame if anything asks for one.
+    /// One turn of the loop: script lines, then a step of a frame (a preview or a full one), or a
+    /// present of the last frame.
     fn step(&mut self) -> Result<()> {
         self.run_script()?;
         if self.quit {
@@ -581,9 +680,19 @@ impl Viewer {
             self.script_frames = self.script_frames.saturating_sub(1);
             return Ok(());
         }
-        let limit_left = self.frames_limit.is_some_and(|n| self.presented < n);
-        if self.dirty || self.script_frames > 0 || limit_left || self.trace.is_some() {
-            self.render_and_present()?;
+        if self.dirty && matches!(self.frame, Some((_, FrameKind::Full, _))) {
+            // A full frame of an old view is dropped; a preview is short and is finished.
+            self.frame = None;
+        }
+        if self.frame.is_none() {
+            if self.dirty && self.interacting() && !self.full_frames_are_fast() {
+                self.begin(FrameKind::Preview)?;
+            } else if self.new_frame_wanted() || self.shown_preview {
+                self.begin(FrameKind::Full)?;
+            }
+        }
+        if self.frame.is_some() {
+            self.shade(Some(STEP_BUDGET))?;
         } else if self.unshown || self.source.is_some() {
             // Exposed or skipped: show the last frame again without rendering it again.
             self.present()?;
@@ -594,14 +703,78 @@ impl Viewer {
         Ok(())
     }
 
-    fn render_and_present(&mut self) -> Result<()> {
+    /// A full frame took so little that previews would not help (a GPU).
+    fn full_frames_are_fast(&self) -> bool {
+        self.last_full_frame_s.is_some_and(|s| s < FAST_FRAME_S)
+    }
+
+    /// Starts a frame of the current view: the window's size, or a fraction of it for a preview.
+    fn begin(&mut self, kind: FrameKind) -> Result<()> {
         let (w, h) = self.size;
-        if w == 0 || h == 0 {
-            return Ok(());
-        }
+        let (w, h) = match kind {
+            FrameKind::Full => (w, h),
+            FrameKind::Preview => ((w / self.preview_divisor).max(1), (h / self.preview_divisor).max(1)),
+        };
         self.renderer.set_size(w, h)?;
-        let scopes = self.renderer.render_frame(&self.scene)?;
+        let started = Instant::now();
+        let frame = self.renderer.begin_frame(&self.scene)?;
+        log::debug!("{kind:?} frame begun (hierarchy, depth) in {:.0} ms", started.elapsed().as_secs_f64() * 1e3);
+        self.frame = Some((frame, kind, started));
         self.dirty = false;
+        Ok(())
+    }
+
+    /// Shades the frame in progress for about `budget` (to the end without one); a finished frame
+    /// is shown. Returns whether it finished.
+    fn shade(&mut self, budget: Option<Duration>) -> Result<bool> {
+        let (frame, kind, started) = self.frame.as_mut().expect("a frame in progress");
+        let (kind, started) = (*kind, *started);
+        let step = Instant::now();
+        let shaded = self.renderer.shade_some(frame, budget)?;
+        log::debug!("shading step {:.0} ms, {:.0}% done", step.elapsed().as_secs_f64() * 1e3, 100.0 * frame.progress());
+        if !shaded {
+            if kind == FrameKind::Full {
+                let (w, h) = self.size;
+                self.window.set_title(&format!(
+                    "translucent — {} — {w}x{h} refining {:.0}%",
+                    self.device_name,
+                    100.0 * frame.progress()
+                ));
+            }
+            return Ok(false);
+        }
+        let (frame, _, _) = self.frame.take().expect("in progress");
+        // One tile longer than a turn's budget: smaller tiles from the next frame on (not on a
+        // device that shades whole frames in one go).
+        let tile = self.renderer.tile_size();
+        if frame.longest_unit_seconds() > STEP_BUDGET.as_secs_f64() && tile > MIN_TILE {
+            self.renderer.set_tile_size((tile / 2).max(MIN_TILE));
+            log::info!("tiles of {} pixels, so that one takes under {} ms", tile / 2, STEP_BUDGET.as_millis());
+        }
+        let scopes = self.renderer.finish_frame(frame)?;
+        let seconds = started.elapsed().as_secs_f64();
+        match kind {
+            FrameKind::Full => {
+                self.last_full_frame_s = Some(seconds);
+                self.shown_preview = false;
+            }
+            FrameKind::Preview => {
+                // Previews of about PREVIEW_TARGET: coarser when slower, finer when faster.
+                if seconds > 2.0 * PREVIEW_TARGET.as_secs_f64() && self.preview_divisor < 16 {
+                    self.preview_divisor *= 2;
+                } else if seconds < 0.5 * PREVIEW_TARGET.as_secs_f64() && self.preview_divisor > 2 {
+                    self.preview_divisor /= 2;
+                }
+                self.shown_preview = true;
+            }
+        }
+        self.frame_rendered(scopes, kind.name(), seconds)?;
+        self.present()?;
+        Ok(true)
+    }
+
+    /// Bookkeeping of a rendered frame: the trace, the frame clock, the title.
+    fn frame_rendered(&mut self, scopes: Vec<TimedScope>, kind: &str, seconds: f64) -> Result<()> {
         self.unshown = true;
         if let Some((left, frames, path)) = self.trace.as_mut() {
             frames.push(scopes.clone());
@@ -614,22 +787,34 @@ impl Viewer {
                 self.trace = None;
             }
         }
-        let gpu_ms: f64 =
-            scopes.iter().filter(|s| !s.name.contains('/')).map(|s| s.end_ns - s.begin_ns).sum::<f64>() / 1e6;
+        // The frame's GPU time: from its first timestamp to its last.
+        let gpu_ms = match (scopes.first(), scopes.last()) {
+            (Some(a), Some(b)) => (b.end_ns - a.begin_ns) / 1e6,
+            _ => 0.0,
+        };
         let now = Instant::now();
         if let Some(last) = self.fps.last.replace(now) {
             self.fps.seconds = (now - last).as_secs_f64();
         }
+        let extent = self.renderer.extent();
         self.window.set_title(&format!(
-            "translucent — {} — {}x{} — frame {:.0} ms ({:.1} fps), GPU {:.0} ms",
+            "translucent — {} — {}x{} {kind} in {:.0} ms (GPU {gpu_ms:.0} ms), {:.1} fps",
             self.device_name,
-            w,
-            h,
-            self.fps.seconds * 1e3,
+            extent.width,
+            extent.height,
+            seconds * 1e3,
             if self.fps.seconds > 0.0 { 1.0 / self.fps.seconds } else { 0.0 },
-            gpu_ms
         ));
-        self.present()
+        log::info!(
+            "{kind} frame {}x{} in {:.0} ms (GPU {gpu_ms:.0} ms), {:.0} ms since the last shown; longest turn {:.0} ms",
+            extent.width,
+            extent.height,
+            seconds * 1e3,
+            self.fps.seconds * 1e3,
+            self.longest_turn_of_frame.as_secs_f64() * 1e3
+        );
+        self.longest_turn_of_frame = Duration::ZERO;
+        Ok(())
     }
 
     fn report(device_name: &str, frames: Vec<Vec<TimedScope>>) -> crate::profiling::ProfileReport {
@@ -675,6 +860,11 @@ impl Viewer {
 
     /// At exit: the `--screenshot`.
     fn finish(&mut self) -> Result<()> {
+        log::info!(
+            "{} frames presented; the longest turn of the event loop took {:.0} ms",
+            self.presented,
+            self.longest_turn.as_secs_f64() * 1e3
+        );
         if let Some(path) = self.screenshot_at_exit.take() {
             self.refine_now()?;
             self.renderer.write_image(&path)?;
