@@ -9,7 +9,6 @@ use crate::error::Result;
 use crate::frame::{FrameOptions, Renderer, Show, SubsurfaceOptions};
 use crate::hierarchy::HierarchyOptions;
 use crate::materials::Material;
-use crate::mesh::Mesh;
 use crate::output::Exposure;
 use crate::physics::{Diffusion, Model};
 use crate::scene::{Camera, Light, Scene};
@@ -208,7 +207,8 @@ impl DeviceArgs {
 #[derive(Args, Debug)]
 pub struct RenderArgs {
     /// Mesh: `sphere`, `box`, `slab`, `torus`, or the path of an OBJ file (default: the Stanford
-    /// bunny from glmark2-data when installed, else the sphere).
+    /// bunny from glmark2-data when installed, else the sphere). A `{frame}` in the path plays a
+    /// sequence of files, one per frame (numbered from 0 or 1, plain or padded to 4 digits).
     #[arg(long)]
     pub mesh: Option<String>,
     /// Output image; the extension picks the format (.png or .exr). A `{frame}` in the name
@@ -227,6 +227,14 @@ pub struct RenderArgs {
     /// centre) every frame: a turntable of light.
     #[arg(long, allow_hyphen_values = true, default_value_t = 0.0, value_parser = finite_f32, value_name = "DEG")]
     pub spin_light: f32,
+    /// Deform the mesh, animated over --deform-period frames (none, full strength, none):
+    /// `twist:DEG` (about the vertical axis, growing with height) or `squash:F` (height × F,
+    /// width / √F). Normals are recomputed every frame.
+    #[arg(long, value_parser = crate::deform::Deformation::parse, value_name = "twist:DEG | squash:F")]
+    pub deform: Option<crate::deform::Deformation>,
+    /// Frames per period of --deform.
+    #[arg(long, default_value_t = 48, value_parser = clap::value_parser!(u32).range(1..))]
+    pub deform_period: u32,
     /// Millimetres per scene unit (materials are given per mm).
     #[arg(long, allow_hyphen_values = true, default_value_t = 10.0, value_parser = positive_f32)]
     pub scale: f32,
@@ -501,7 +509,7 @@ pub fn mesh_spec(args: &RenderArgs) -> String {
 }
 
 pub fn build_scene(args: &RenderArgs) -> Result<Scene> {
-    let mesh = Mesh::from_spec(&mesh_spec(args))?;
+    let mesh = crate::deform::first_mesh(&mesh_spec(args))?;
     let (centre, radius) = crate::scene::bounding_sphere(&mesh.positions);
     let mut camera = Camera::framing(centre, radius, args.fov, Vec3::new(0.3, 0.3, 1.0));
     camera.up = args.up;
@@ -606,12 +614,18 @@ fn render(args: &RenderArgs) -> Result<i32> {
     renderer.progress = Some(bar.clone());
 
     let every_frame = args.out.to_string_lossy().contains("{frame}");
+    let animation =
+        crate::deform::Animation::new(&mesh_spec(args), &scene.mesh, args.deform, args.deform_period, args.up)?;
     let base_lights = scene.lights.clone();
     let (centre, _) = crate::scene::bounding_sphere(&scene.mesh.positions);
     let mut frames = Vec::new();
     for index in 0..args.frames {
         let angle = (args.spin_light * index as f32).to_radians();
         scene.lights = base_lights.iter().map(|l| l.rotated(args.up, angle, centre)).collect();
+        if let Some(animation) = animation.as_ref().filter(|_| index > 0) {
+            scene.mesh = animation.mesh(index)?;
+            renderer.set_mesh(&scene.mesh)?;
+        }
         frames.push(renderer.render_frame(&scene)?);
         if every_frame {
             let path = frame_path(&args.out, index);

@@ -376,6 +376,31 @@ impl Renderer {
         self.whole_frame = false;
     }
 
+    /// Draws `mesh` from the next frame on (a deformed mesh, the next of a sequence): new vertex
+    /// and index buffers, the hierarchy's triangle count, bounds and shadow matrices. The point
+    /// count stays; the points are sampled on the new surface, as every frame.
+    pub fn set_mesh(&mut self, mesh: &crate::mesh::Mesh) -> Result<()> {
+        mesh.validate()?;
+        let index_count = u32::try_from(mesh.indices.len()).map_err(|_| bad_input!("mesh: too many indices"))?;
+        // A window's copy of the last image may still be in flight; nothing else uses the buffers.
+        self.ctx.wait_idle()?;
+        self.vertices = vk::upload_buffer(
+            &self.ctx,
+            "vertices",
+            &mesh.vertex_data(),
+            BufferUsageFlags::VERTEX_BUFFER | BufferUsageFlags::STORAGE_BUFFER,
+        )?;
+        self.indices = vk::upload_buffer(
+            &self.ctx,
+            "indices",
+            &mesh.indices,
+            BufferUsageFlags::INDEX_BUFFER | BufferUsageFlags::STORAGE_BUFFER,
+        )?;
+        self.index_count = index_count;
+        self.bounds = mesh.bounds();
+        self.hierarchy.set_mesh(&self.ctx, mesh, &self.lights)
+    }
+
     /// The side of the shading tiles in pixels (when not shading whole frames).
     pub fn tile_size(&self) -> u32 {
         self.tile

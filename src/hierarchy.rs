@@ -343,6 +343,27 @@ impl Hierarchy {
     pub fn bounds(&self) -> (Vec3, Vec3) {
         self.bounds
     }
+
+    /// Follows a mesh that changed (deformed, or the next of a sequence): its triangle count,
+    /// its bounds (the Morton codes' box) and the lights' shadow matrices. The point count stays.
+    pub fn set_mesh(&mut self, ctx: &Context, mesh: &Mesh, lights: &[Light]) -> Result<()> {
+        let triangles = mesh.triangle_count() as u32;
+        if triangles != self.triangle_count {
+            self.prefix = Buffer::new(
+                ctx,
+                "triangle area prefix sum",
+                (triangles as u64 + 1) * 4,
+                BufferUsageFlags::STORAGE_BUFFER | BufferUsageFlags::TRANSFER_SRC | BufferUsageFlags::TRANSFER_DST,
+                MemoryLocation::GpuOnly,
+            )?;
+            self.triangle_count = triangles;
+        }
+        self.index_count = mesh.indices.len() as u32;
+        let (lo, hi) = mesh.bounds();
+        let pad = (hi - lo).max_element() * 1e-3;
+        self.bounds = (lo - Vec3::splat(pad), hi + Vec3::splat(pad));
+        self.set_lights(mesh, lights)
+    }
 }
 
 pub struct Snapshot {

@@ -4,6 +4,7 @@
 pub mod bench;
 pub mod bssrdf_csv;
 pub mod cli;
+pub mod deform;
 pub mod error;
 pub mod frame;
 pub mod hierarchy;

@@ -218,6 +218,45 @@ fn light_dragged_behind_the_object_brightens_its_rim() {
 }
 
 #[test]
+fn a_deforming_mesh_plays_pauses_and_matches_render() {
+    if !have_xvfb() {
+        return;
+    }
+    let (a, b, c) = (png("deform-a"), png("deform-b"), png("deform-c"));
+    let mut args = vec!["--mesh", "box", "--deform", "twist:90", "--deform-period", "2"];
+    args.extend_from_slice(&SCENE[2..]);
+    let lines = [
+        "pause".to_string(),
+        format!("screenshot {}", a.display()),
+        "pause".into(),
+        // Steps 0 (the box) and 1 (twisted 90°), then held there.
+        "frames 2".into(),
+        "pause".into(),
+        format!("screenshot {}", b.display()),
+        "frames 2".into(),
+        format!("screenshot {}", c.display()),
+        "quit".into(),
+    ];
+    let lines: Vec<&str> = lines.iter().map(|s| s.as_str()).collect();
+    assert_ok("deform", &view("deform", &args, &lines));
+    let (a, b, c) = (load(&a), load(&b), load(&c));
+    assert!(output::compare(&a, &b).unwrap().differing_fraction > 0.05, "the twist must show");
+    let held = output::compare(&b, &c).unwrap();
+    assert!(held.rmse < 0.5, "paused: the mesh must stay: {held:?}");
+
+    // `render --frames 2` writes the same two steps.
+    let out = output_dir().join("view-deform-render-{frame}.png");
+    let mut render = vec!["render", "--validation"];
+    render.extend_from_slice(&args);
+    render.extend_from_slice(&["--frames", "2", "--out", out.to_str().unwrap()]);
+    let result = translucent(&render);
+    assert!(result.status.success(), "{}", stderr(&result));
+    let rendered = load(&output_dir().join("view-deform-render-0001.png"));
+    let same = output::compare(&b, &rendered).unwrap();
+    assert!(same.rmse < 0.5 && same.differing_fraction < 0.001, "view and render differ: {same:?}");
+}
+
+#[test]
 fn bad_script_line_exits_2_naming_the_line() {
     let script = output_dir().join("bad.script");
     std::fs::write(&script, "orbit 10 0\nzoom 1.2\norbitt 5 5\nquit\n").unwrap();

@@ -335,6 +335,10 @@ struct Viewer {
     /// The last frame shown was a preview: refine once the interaction stops.
     shown_preview: bool,
     last_interaction: Option<Instant>,
+    /// A mesh sequence or deformation, the step shown, and whether it plays.
+    animation: Option<crate::deform::Animation>,
+    animation_frame: u32,
+    playing: bool,
     /// The longest turn of the event loop spent in the viewer (reported at exit).
     longest_turn: Duration,
     /// The same since the last frame was shown.
@@ -402,6 +406,8 @@ impl Viewer {
             renderer.set_tile_size(MIN_TILE);
         }
         let (centre, _) = crate::scene::bounding_sphere(&scene.mesh.positions);
+        let animation =
+            crate::deform::Animation::new(&cli::mesh_spec(r), &scene.mesh, r.deform, r.deform_period, r.up)?;
         Ok(Viewer {
             source: None,
             presenter,
@@ -429,6 +435,9 @@ impl Viewer {
             last_full_frame_s: None,
             shown_preview: false,
             last_interaction: None,
+            animation,
+            animation_frame: 0,
+            playing: true,
             longest_turn: Duration::ZERO,
             longest_turn_of_frame: Duration::ZERO,
         })
@@ -441,7 +450,8 @@ impl Viewer {
     /// Whether a new frame is asked for (not counting the refinement of a preview).
     fn new_frame_wanted(&self) -> bool {
         let limit_left = self.frames_limit.is_some_and(|n| self.presented < n);
-        self.dirty || self.script_frames > 0 || limit_left || self.trace.is_some()
+        let playing = self.playing && self.animation.is_some();
+        self.dirty || self.script_frames > 0 || limit_left || self.trace.is_some() || playing
     }
 
     /// When the loop should come round again.
@@ -616,7 +626,7 @@ impl Viewer {
                     }
                 }
             }
-            Action::TogglePause => {}
+            Action::TogglePause => self.playing = !self.playing,
             Action::Trace(frames, path) => {
                 self.trace = Some((frames, Vec::new(), path));
                 self.dirty = true;
@@ -717,6 +727,13 @@ impl Viewer {
         };
         self.renderer.set_size(w, h)?;
         let started = Instant::now();
+        if let Some(animation) = self.animation.as_ref().filter(|_| self.playing) {
+            // This step of the sequence or deformation (normals recomputed); the next frame shows
+            // the next.
+            self.scene.mesh = animation.mesh(self.animation_frame)?;
+            self.renderer.set_mesh(&self.scene.mesh)?;
+            self.animation_frame += 1;
+        }
         let frame = self.renderer.begin_frame(&self.scene)?;
         log::debug!("{kind:?} frame begun (hierarchy, depth) in {:.0} ms", started.elapsed().as_secs_f64() * 1e3);
         self.frame = Some((frame, kind, started));
