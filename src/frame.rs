@@ -347,7 +347,34 @@ impl Renderer {
         params.count_work = count_work;
         self.subsurface_params.write(0, &[params])?;
         self.brute_force = subsurface.brute_force;
-        Ok(())
+        self.hierarchy.set_eta(subsurface.material.eta as f32)
+    }
+
+    /// Samples `point_count` points from the next frame on: a new hierarchy for `mesh` (the
+    /// scene's current mesh) with the same shadow resolution and η.
+    pub fn set_point_count(&mut self, point_count: u32, mesh: &crate::mesh::Mesh) -> Result<()> {
+        if point_count == self.hierarchy.point_count {
+            return Ok(());
+        }
+        self.ctx.wait_idle()?;
+        let options = HierarchyOptions {
+            point_count,
+            shadow_resolution: self.hierarchy.shadow_map.extent.width,
+            eta: self.hierarchy.eta(),
+        };
+        self.hierarchy = Hierarchy::new(&self.ctx, mesh, &self.lights, &options)?;
+        let mut params = self.subsurface_params.read::<SubsurfaceParams>(1)?[0];
+        (params.point_count, params.node_count) = (point_count, point_count - 1);
+        self.subsurface_params.write(0, &[params])
+    }
+
+    pub fn show(&self) -> Show {
+        self.show
+    }
+
+    /// What to draw over the shading from the next frame on.
+    pub fn set_show(&mut self, show: Show) {
+        self.show = show;
     }
 
     /// Exposure of the tone-mapped image from the next frame on.

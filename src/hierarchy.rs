@@ -344,6 +344,17 @@ impl Hierarchy {
         self.bounds
     }
 
+    pub fn eta(&self) -> f32 {
+        self.eta
+    }
+
+    /// The relative index of refraction used for the light entering the surface (a material
+    /// change); written into the light set at once.
+    pub fn set_eta(&mut self, eta: f32) -> Result<()> {
+        self.eta = eta;
+        self.lights.write(std::mem::offset_of!(LightSetHeader, eta) as u64, &[eta])
+    }
+
     /// Follows a mesh that changed (deformed, or the next of a sequence): its triangle count,
     /// its bounds (the Morton codes' box) and the lights' shadow matrices. The point count stays.
     pub fn set_mesh(&mut self, ctx: &Context, mesh: &Mesh, lights: &[Light]) -> Result<()> {

@@ -257,6 +257,47 @@ fn a_deforming_mesh_plays_pauses_and_matches_render() {
 }
 
 #[test]
+fn panel_settings_take_effect_on_the_next_frame() {
+    if !have_xvfb() {
+        return;
+    }
+    let shots: Vec<PathBuf> =
+        ["plain", "samples", "brute", "dipole"].iter().map(|n| png(&format!("panel-{n}"))).collect();
+    let lines = [
+        "set samples 1024".to_string(),
+        format!("screenshot {}", shots[0].display()),
+        "set show samples".into(),
+        format!("screenshot {}", shots[1].display()),
+        "set show shading".into(),
+        "set brute-force on".into(),
+        format!("screenshot {}", shots[2].display()),
+        "set brute-force off".into(),
+        "set model dipole".into(),
+        "set specular off".into(),
+        "set eta 1.3".into(),
+        "set epsilon 0.2".into(),
+        "set exposure 1".into(),
+        format!("screenshot {}", shots[3].display()),
+        "quit".into(),
+    ];
+    let lines: Vec<&str> = lines.iter().map(|s| s.as_str()).collect();
+    let out = view("panel", SCENE, &lines);
+    assert_ok("panel", &out);
+    let images: Vec<_> = shots.iter().map(|p| load(p)).collect();
+    let differs = |i: usize| output::compare(&images[0], &images[i]).unwrap();
+    assert!(differs(1).differing_fraction > 0.01, "the sample points must show: {:?}", differs(1));
+    // Brute force and the tree agree closely (the tree's error at ε = 0.1 is about 1%).
+    assert!(differs(2).rmse < 4.0, "brute force vs tree: {:?}", differs(2));
+    assert!(differs(3).rmse > 5.0, "model, specular, η, ε and exposure changed: {:?}", differs(3));
+    // Each full frame prints its per-pass GPU times.
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.lines().any(|l| l.contains("1024 points") && l.contains("shade") && l.contains("tone mapping")),
+        "{stdout}"
+    );
+}
+
+#[test]
 fn bad_script_line_exits_2_naming_the_line() {
     let script = output_dir().join("bad.script");
     std::fs::write(&script, "orbit 10 0\nzoom 1.2\norbitt 5 5\nquit\n").unwrap();

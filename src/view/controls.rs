@@ -62,6 +62,11 @@ pub enum Setting {
     SigmaA([f64; 3]),
     SigmaS([f64; 3]),
     G([f64; 3]),
+    Eta(f64),
+    /// Sample points (a new hierarchy).
+    Samples(u32),
+    /// The debug view drawn over the shading.
+    Show(crate::frame::Show),
 }
 
 /// A parsed script line, with its 1-based number for messages.
@@ -207,9 +212,23 @@ pub fn parse_line(line: &str) -> std::result::Result<Action, String> {
                 "sigma-a" => Setting::SigmaA(triple(value)?),
                 "sigma-s" => Setting::SigmaS(triple(value)?),
                 "g" => Setting::G(triple(value)?),
+                "eta" => Setting::Eta(number(value)? as f64),
+                "samples" => {
+                    let n = count(value)?;
+                    if n < 2 {
+                        return Err(format!("samples {n}: at least 2"));
+                    }
+                    Setting::Samples(n)
+                }
+                "show" => Setting::Show(match value.split_once(':') {
+                    None if value == "shading" => crate::frame::Show::Shading,
+                    None if value == "samples" => crate::frame::Show::Samples,
+                    Some(("tree", level)) => crate::frame::Show::Tree(count(level)?),
+                    _ => return Err(format!("show '{value}': shading, samples or tree:LEVEL")),
+                }),
                 other => {
                     return Err(format!(
-                        "unknown setting '{other}' (epsilon, exposure, specular, roughness, model, brute-force, sigma-a, sigma-s, g)"
+                        "unknown setting '{other}' (epsilon, exposure, specular, roughness, model, brute-force, sigma-a, sigma-s, g, eta, samples, show)"
                     ))
                 }
             })

@@ -335,6 +335,8 @@ struct Viewer {
     /// The last frame shown was a preview: refine once the interaction stops.
     shown_preview: bool,
     last_interaction: Option<Instant>,
+    /// The exposure in stops the keys step from (auto counts as 0).
+    exposure_stops: f32,
     /// A mesh sequence or deformation, the step shown, and whether it plays.
     animation: Option<crate::deform::Animation>,
     animation_frame: u32,
@@ -435,6 +437,7 @@ impl Viewer {
             last_full_frame_s: None,
             shown_preview: false,
             last_interaction: None,
+            exposure_stops: r.exposure.unwrap_or(0.0),
             animation,
             animation_frame: 0,
             playing: true,
@@ -541,6 +544,30 @@ impl Viewer {
                 "i" => Action::TurnLights { right_deg: 0.0, up_deg: step },
                 "k" => Action::TurnLights { right_deg: 0.0, up_deg: -step },
                 "p" => Action::Screenshot(next_free_path("translucent-view", "png")),
+                // The panel's settings, from the keys.
+                "m" => {
+                    let presets = crate::materials::Material::presets();
+                    let now = presets.iter().position(|m| m.name == self.subsurface.material.name).unwrap_or(0);
+                    Action::Material(
+                        presets[(now + if shift { presets.len() - 1 } else { 1 }) % presets.len()].name.clone(),
+                    )
+                }
+                "d" => Action::Set(Setting::Model(match self.subsurface.model {
+                    crate::physics::Model::Directional => crate::physics::Model::Dipole,
+                    crate::physics::Model::Dipole => crate::physics::Model::Directional,
+                })),
+                "b" => Action::Set(Setting::BruteForce(!self.subsurface.brute_force)),
+                "s" => Action::Set(Setting::Specular(!self.subsurface.specular)),
+                "[" => Action::Set(Setting::Epsilon(self.subsurface.epsilon / 2.0)),
+                "]" => Action::Set(Setting::Epsilon((self.subsurface.epsilon * 2.0).max(1e-3))),
+                "," => Action::Set(Setting::Exposure(Some(self.exposure_stops - 0.5))),
+                "." => Action::Set(Setting::Exposure(Some(self.exposure_stops + 0.5))),
+                "v" => Action::Set(Setting::Show(match self.renderer.show() {
+                    Show::Shading => Show::Samples,
+                    Show::Samples => Show::Tree(2),
+                    Show::Tree(l) if l < 8 => Show::Tree(l + 2),
+                    Show::Tree(_) => Show::Shading,
+                })),
                 "t" => Action::Trace(10, next_free_path("translucent-trace", "json")),
                 _ => return Ok(()),
             },
@@ -587,6 +614,7 @@ impl Viewer {
                 match setting {
                     Setting::Epsilon(e) => s.epsilon = e,
                     Setting::Exposure(stops) => {
+                        self.exposure_stops = stops.unwrap_or(0.0);
                         self.renderer.set_exposure(stops.map(Exposure::Stops).unwrap_or(Exposure::Auto))
                     }
                     Setting::Specular(on) => s.specular = on,
@@ -596,6 +624,9 @@ impl Viewer {
                     Setting::SigmaA(v) => s.material.sigma_a = v,
                     Setting::SigmaS(v) => s.material.sigma_s = v,
                     Setting::G(v) => s.material.g = v,
+                    Setting::Eta(v) => s.material.eta = v,
+                    Setting::Samples(n) => self.renderer.set_point_count(n, &self.scene.mesh)?,
+                    Setting::Show(show) => self.renderer.set_show(show),
                 }
                 self.subsurface.material.validate()?;
                 self.update_subsurface()?;
@@ -814,14 +845,33 @@ impl Viewer {
             self.fps.seconds = (now - last).as_secs_f64();
         }
         let extent = self.renderer.extent();
+        let points = self.renderer.hierarchy.point_count;
+        let work = self.renderer.work()?;
+        let per_pixel = if work.pixels > 0 {
+            let px = work.pixels as f64;
+            format!(", {:.1} nodes and {:.1} points per pixel", work.node_sum as f64 / px, work.point_sum as f64 / px)
+        } else {
+            String::new()
+        };
         self.window.set_title(&format!(
-            "translucent — {} — {}x{} {kind} in {:.0} ms (GPU {gpu_ms:.0} ms), {:.1} fps",
+            "translucent — {} — {}x{} {kind} in {:.0} ms (GPU {gpu_ms:.0} ms), {:.1} fps — {points} points{per_pixel}",
             self.device_name,
             extent.width,
             extent.height,
             seconds * 1e3,
             if self.fps.seconds > 0.0 { 1.0 / self.fps.seconds } else { 0.0 },
         ));
+        if kind == FrameKind::Full.name() {
+            // The per-pass GPU times of every full frame, as `render` prints them per run.
+            println!(
+                "frame {} {}x{} in {:.0} ms, {points} points{per_pixel}: {}",
+                self.presented + 1,
+                extent.width,
+                extent.height,
+                seconds * 1e3,
+                pass_times(&scopes)
+            );
+        }
         log::info!(
             "{kind} frame {}x{} in {:.0} ms (GPU {gpu_ms:.0} ms), {:.0} ms since the last shown; longest turn {:.0} ms",
             extent.width,
@@ -896,6 +946,19 @@ impl Drop for Viewer {
         // The window image goes first, and a present may still be reading it.
         let _ = self.renderer.ctx.wait_idle();
     }
+}
+
+/// `name ms` per pass, in the order of the frame, passes that repeat (shading submissions) summed.
+fn pass_times(scopes: &[TimedScope]) -> String {
+    let mut passes: Vec<(&str, f64)> = Vec::new();
+    for s in scopes {
+        let ms = (s.end_ns - s.begin_ns) / 1e6;
+        match passes.iter_mut().find(|(name, _)| *name == s.name) {
+            Some((_, total)) => *total += ms,
+            None => passes.push((&s.name, ms)),
+        }
+    }
+    passes.iter().map(|(name, ms)| format!("{name} {ms:.1} ms")).collect::<Vec<_>>().join(", ")
 }
 
 /// `stem-0000.ext`, the first number not taken in the working folder.
