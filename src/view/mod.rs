@@ -5,6 +5,7 @@
 //! is copied into an image that the presenter blits to the window (src/vk/swapchain.rs).
 
 pub mod controls;
+mod panel;
 
 use std::collections::VecDeque;
 use std::path::PathBuf;
@@ -42,6 +43,9 @@ pub struct ViewArgs {
     /// Write the last presented image (PNG) when the viewer exits.
     #[arg(long, value_name = "FILE.png")]
     pub screenshot: Option<PathBuf>,
+    /// Leave out the panel (settings and timings drawn over the image; `h` toggles it).
+    #[arg(long)]
+    pub no_panel: bool,
     /// Run the commands of this file, one per line (orbit, pan, zoom, light, material, set,
     /// frames, screenshot, resize, pause, trace, quit; see README "View").
     #[arg(long, value_name = "FILE")]
@@ -170,7 +174,24 @@ impl ApplicationHandler for App<'_> {
 
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
         let Some(viewer) = self.viewer.as_mut() else { return };
+        // The panel sees every event first; what it takes (a click on it, typing into it) goes no
+        // further, except cursor positions, which the drags need to stay continuous.
+        let mut consumed = false;
+        if let Some(ui) = viewer.ui.as_mut().filter(|ui| ui.shown) {
+            let response = ui.state.on_window_event(&viewer.window, &event);
+            if response.repaint {
+                viewer.ui_repaint = true;
+            }
+            consumed = response.consumed && !matches!(event, WindowEvent::CursorMoved { .. });
+        }
         let result = match event {
+            WindowEvent::MouseInput { state, button, .. } if consumed => {
+                if state == ElementState::Released {
+                    viewer.input.buttons.retain(|b| *b != button);
+                }
+                Ok(())
+            }
+            WindowEvent::MouseWheel { .. } | WindowEvent::KeyboardInput { .. } if consumed => Ok(()),
             WindowEvent::CloseRequested => {
                 viewer.quit = true;
                 Ok(())
@@ -293,11 +314,58 @@ struct Input {
 /// Degrees of orbit per pixel dragged.
 const DEGREES_PER_PIXEL: f32 = 0.4;
 
+/// The panel: egui's input state and its renderer over the swapchain image.
+struct Ui {
+    state: egui_winit::State,
+    overlay: vk::Overlay,
+    shown: bool,
+}
+
+/// The last frames' numbers, for the panel.
+#[derive(Default)]
+struct PanelNumbers {
+    device: String,
+    last_frame: String,
+    fps: f64,
+    work_per_pixel: Option<(f64, f64)>,
+    passes: Vec<(String, f64)>,
+    refining: Option<f32>,
+}
+
+fn panel_state(
+    numbers: &PanelNumbers,
+    subsurface: &SubsurfaceOptions,
+    renderer: &Renderer,
+    exposure: Option<f32>,
+    playing: Option<bool>,
+) -> panel::PanelState {
+    panel::PanelState {
+        material: subsurface.material.clone(),
+        model: subsurface.model,
+        epsilon: subsurface.epsilon,
+        samples: renderer.hierarchy.point_count,
+        exposure,
+        specular: subsurface.specular,
+        roughness: subsurface.roughness,
+        brute_force: subsurface.brute_force,
+        show: renderer.show(),
+        playing,
+        device: numbers.device.clone(),
+        last_frame: numbers.last_frame.clone(),
+        fps: numbers.fps,
+        work_per_pixel: numbers.work_per_pixel,
+        passes: numbers.passes.clone(),
+        refining: numbers.refining,
+    }
+}
+
 struct Viewer {
-    // Field order is drop order: the image and presenter (surface) before the renderer (which owns
-    // the device), the window last.
+    // Field order is drop order: the image, panel and presenter (surface) before the renderer
+    // (which owns the device), the window last.
     /// The tone-mapped image in the swapchain's 8-bit encoding, blitted to the window.
     source: Option<Image>,
+    /// The panel, when shown.
+    ui: Option<Ui>,
     presenter: Presenter,
     renderer: Renderer,
     window: Arc<Window>,
@@ -341,6 +409,14 @@ struct Viewer {
     animation: Option<crate::deform::Animation>,
     animation_frame: u32,
     playing: bool,
+    /// The panel asked to be drawn again.
+    ui_repaint: bool,
+    /// Changes made on the panel, applied at the start of the next turn.
+    pending_actions: Vec<Action>,
+    /// The numbers the panel shows about the last frames.
+    panel_numbers: PanelNumbers,
+    /// Exposure as set (`None`: automatic).
+    exposure: Option<f32>,
     /// The longest turn of the event loop spent in the viewer (reported at exit).
     longest_turn: Duration,
     /// The same since the last frame was shown.
@@ -408,8 +484,24 @@ impl Viewer {
             renderer.set_tile_size(MIN_TILE);
         }
         let (centre, _) = crate::scene::bounding_sphere(&scene.mesh.positions);
+        let device_label = device_name.clone();
         let animation =
             crate::deform::Animation::new(&cli::mesh_spec(r), &scene.mesh, r.deform, r.deform_period, r.up)?;
+        let ui = if args.no_panel {
+            None
+        } else {
+            let egui_ctx = egui::Context::default();
+            let state = egui_winit::State::new(
+                egui_ctx,
+                egui::ViewportId::ROOT,
+                &window,
+                Some(window.scale_factor() as f32),
+                None,
+                Some(renderer.ctx.limits().max_image_dimension2_d as usize),
+            );
+            let overlay = vk::Overlay::new(&renderer.ctx, presenter.surface_format())?;
+            Some(Ui { state, overlay, shown: true })
+        };
         Ok(Viewer {
             source: None,
             presenter,
@@ -441,6 +533,11 @@ impl Viewer {
             animation,
             animation_frame: 0,
             playing: true,
+            ui,
+            ui_repaint: true,
+            pending_actions: Vec::new(),
+            panel_numbers: PanelNumbers { device: device_label, ..Default::default() },
+            exposure: r.exposure,
             longest_turn: Duration::ZERO,
             longest_turn_of_frame: Duration::ZERO,
         })
@@ -470,7 +567,13 @@ impl Viewer {
         if self.minimised() {
             return if self.script_frames > 0 || !self.script.is_empty() { Turn::Now } else { Turn::OnInput };
         }
-        if self.new_frame_wanted() || self.frame.is_some() || self.unshown || !self.script.is_empty() {
+        if self.new_frame_wanted()
+            || self.frame.is_some()
+            || self.unshown
+            || self.ui_repaint
+            || !self.pending_actions.is_empty()
+            || !self.script.is_empty()
+        {
             return Turn::Now;
         }
         match (self.shown_preview, self.last_interaction) {
@@ -544,6 +647,13 @@ impl Viewer {
                 "i" => Action::TurnLights { right_deg: 0.0, up_deg: step },
                 "k" => Action::TurnLights { right_deg: 0.0, up_deg: -step },
                 "p" => Action::Screenshot(next_free_path("translucent-view", "png")),
+                "h" => {
+                    if let Some(ui) = self.ui.as_mut() {
+                        ui.shown = !ui.shown;
+                        self.ui_repaint = true;
+                    }
+                    return Ok(());
+                }
                 // The panel's settings, from the keys.
                 "m" => {
                     let presets = crate::materials::Material::presets();
@@ -615,6 +725,7 @@ impl Viewer {
                     Setting::Epsilon(e) => s.epsilon = e,
                     Setting::Exposure(stops) => {
                         self.exposure_stops = stops.unwrap_or(0.0);
+                        self.exposure = stops;
                         self.renderer.set_exposure(stops.map(Exposure::Stops).unwrap_or(Exposure::Auto))
                     }
                     Setting::Specular(on) => s.specular = on,
@@ -712,6 +823,10 @@ impl Viewer {
     /// One turn of the loop: script lines, then a step of a frame (a preview or a full one), or a
     /// present of the last frame.
     fn step(&mut self) -> Result<()> {
+        // The panel's changes of the last present, for this frame.
+        for action in std::mem::take(&mut self.pending_actions) {
+            self.apply(action)?;
+        }
         self.run_script()?;
         if self.quit {
             return Ok(());
@@ -733,7 +848,11 @@ impl Viewer {
             }
         }
         if self.frame.is_some() {
-            self.shade(Some(STEP_BUDGET))?;
+            let finished = self.shade(Some(STEP_BUDGET))?;
+            if !finished && self.ui_repaint && !self.unshown {
+                // The panel stays live while a frame is refined: the last image again, new panel.
+                self.present()?;
+            }
         } else if self.unshown || self.source.is_some() {
             // Exposed or skipped: show the last frame again without rendering it again.
             self.present()?;
@@ -782,6 +901,8 @@ impl Viewer {
         log::debug!("shading step {:.0} ms, {:.0}% done", step.elapsed().as_secs_f64() * 1e3, 100.0 * frame.progress());
         if !shaded {
             if kind == FrameKind::Full {
+                self.panel_numbers.refining = Some(frame.progress());
+                self.ui_repaint = true;
                 let (w, h) = self.size;
                 self.window.set_title(&format!(
                     "translucent — {} — {w}x{h} refining {:.0}%",
@@ -861,7 +982,13 @@ impl Viewer {
             seconds * 1e3,
             if self.fps.seconds > 0.0 { 1.0 / self.fps.seconds } else { 0.0 },
         ));
+        self.panel_numbers.last_frame = format!("{}x{} {kind} in {:.0} ms", extent.width, extent.height, seconds * 1e3);
+        self.panel_numbers.fps = if self.fps.seconds > 0.0 { 1.0 / self.fps.seconds } else { 0.0 };
+        self.panel_numbers.work_per_pixel = (work.pixels > 0)
+            .then(|| (work.node_sum as f64 / work.pixels as f64, work.point_sum as f64 / work.pixels as f64));
+        self.panel_numbers.refining = None;
         if kind == FrameKind::Full.name() {
+            self.panel_numbers.passes = pass_list(&scopes);
             // The per-pass GPU times of every full frame, as `render` prints them per run.
             println!(
                 "frame {} {}x{} in {:.0} ms, {points} points{per_pixel}: {}",
@@ -897,27 +1024,51 @@ impl Viewer {
         }
     }
 
-    /// Copies the last rendered frame into the window's image and shows it.
+    /// Shows the last finished frame (copied into the window's image once) with the panel.
     fn present(&mut self) -> Result<()> {
-        let extent = self.renderer.extent();
-        let format = self.presenter.source_format();
-        if self.source.as_ref().is_none_or(|s| s.extent != extent) {
-            // The previous image may still be read by a present in flight.
-            self.renderer.ctx.wait_idle()?;
-            self.source = Some(Image::new_2d(
-                &self.renderer.ctx,
-                "window image",
-                format,
-                extent,
-                1,
-                // SAMPLED only because every Image has a view, which needs a usage views allow.
-                ImageUsageFlags::TRANSFER_DST | ImageUsageFlags::TRANSFER_SRC | ImageUsageFlags::SAMPLED,
-            )?);
+        let ctx = &self.renderer.ctx;
+        let fresh = self.unshown;
+        if fresh {
+            let extent = self.renderer.extent();
+            if self.source.as_ref().is_none_or(|s| s.extent != extent) {
+                // The previous image may still be read by a present in flight.
+                ctx.wait_idle()?;
+                self.source = Some(Image::new_2d(
+                    ctx,
+                    "window image",
+                    self.presenter.source_format(),
+                    extent,
+                    1,
+                    // SAMPLED only because every Image has a view, which needs a usage views allow.
+                    ImageUsageFlags::TRANSFER_DST | ImageUsageFlags::TRANSFER_SRC | ImageUsageFlags::SAMPLED,
+                )?);
+            }
         }
-        let source = self.source.as_ref().expect("made above");
+        let Some(source) = self.source.as_ref() else { return Ok(()) };
         let ldr = self.renderer.tone_mapped_buffer();
-        let shown = self.presenter.present(&self.renderer.ctx, source, |rec| rec.copy_buffer_to_image(ldr, source))?;
-        if shown == Presented::Shown {
+        // The tone-mapped buffer is copied once per finished frame: while the next is in progress
+        // it may be of another size.
+        let copy = |rec: &mut vk::Recorder| if fresh { rec.copy_buffer_to_image(ldr, source) } else { Ok(()) };
+        let playing = self.animation.as_ref().map(|_| self.playing);
+        let shown = match self.ui.as_mut().filter(|ui| ui.shown) {
+            Some(ui) => {
+                let state = panel_state(&self.panel_numbers, &self.subsurface, &self.renderer, self.exposure, playing);
+                let input = ui.state.take_egui_input(&self.window);
+                let mut actions = Vec::new();
+                let output = ui.state.egui_ctx().run_ui(input, |ui| panel::draw(ui.ctx(), &state, &mut actions));
+                ui.state.handle_platform_output(&self.window, output.platform_output);
+                let primitives = ui.state.egui_ctx().tessellate(output.shapes, output.pixels_per_point);
+                ui.overlay.set_textures(ctx, &output.textures_delta)?;
+                let frame = vk::OverlayFrame { primitives: &primitives, pixels_per_point: output.pixels_per_point };
+                let shown = self.presenter.present(ctx, source, copy, Some((&mut ui.overlay, &frame)))?;
+                ui.overlay.free_textures(ctx, &output.textures_delta)?;
+                self.pending_actions.extend(actions);
+                shown
+            }
+            None => self.presenter.present(ctx, source, copy, None)?,
+        };
+        self.ui_repaint = false;
+        if shown == Presented::Shown && fresh {
             self.unshown = false;
             self.presented += 1;
             self.script_frames = self.script_frames.saturating_sub(1);
@@ -948,17 +1099,22 @@ impl Drop for Viewer {
     }
 }
 
-/// `name ms` per pass, in the order of the frame, passes that repeat (shading submissions) summed.
-fn pass_times(scopes: &[TimedScope]) -> String {
-    let mut passes: Vec<(&str, f64)> = Vec::new();
+/// Milliseconds per pass, in the order of the frame, passes that repeat (shading submissions) summed.
+fn pass_list(scopes: &[TimedScope]) -> Vec<(String, f64)> {
+    let mut passes: Vec<(String, f64)> = Vec::new();
     for s in scopes {
         let ms = (s.end_ns - s.begin_ns) / 1e6;
         match passes.iter_mut().find(|(name, _)| *name == s.name) {
             Some((_, total)) => *total += ms,
-            None => passes.push((&s.name, ms)),
+            None => passes.push((s.name.clone(), ms)),
         }
     }
-    passes.iter().map(|(name, ms)| format!("{name} {ms:.1} ms")).collect::<Vec<_>>().join(", ")
+    passes
+}
+
+/// `name ms` per pass (see [`pass_list`]).
+fn pass_times(scopes: &[TimedScope]) -> String {
+    pass_list(scopes).iter().map(|(name, ms)| format!("{name} {ms:.1} ms")).collect::<Vec<_>>().join(", ")
 }
 
 /// `stem-0000.ext`, the first number not taken in the working folder.

@@ -656,7 +656,14 @@ impl<'a> Recorder<'a> {
     /// Scales all of `src` onto all of a swapchain image (not a tracked [`Image`]), whose earlier
     /// contents are discarded, and leaves it ready to present. Blitting converts between the
     /// source's RGBA and the swapchain's channel order.
-    pub(crate) fn blit_to_swapchain(&mut self, src: &Image, dst: vk::Image, dst_extent: vk::Extent2D) -> Result<()> {
+    pub(crate) fn blit_to_swapchain(
+        &mut self,
+        src: &Image,
+        dst: vk::Image,
+        dst_view: vk::ImageView,
+        dst_extent: vk::Extent2D,
+        overlay: Option<(&mut super::overlay::Overlay, &super::overlay::OverlayFrame)>,
+    ) -> Result<()> {
         self.use_image(src, Access::TRANSFER_READ)?;
         let range = vk::ImageSubresourceRange {
             aspect_mask: vk::ImageAspectFlags::COLOR,
@@ -691,15 +698,36 @@ impl<'a> Recorder<'a> {
             dst_subresource: layers,
             dst_offsets: [vk::Offset3D::default(), corner(dst_extent)],
         }];
+        // With an overlay, the blit's result is drawn over as a colour attachment.
+        let to_overlay = [vk::ImageMemoryBarrier2::default()
+            .src_stage_mask(vk::PipelineStageFlags2::BLIT)
+            .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+            .dst_stage_mask(vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT)
+            .dst_access_mask(vk::AccessFlags2::COLOR_ATTACHMENT_READ | vk::AccessFlags2::COLOR_ATTACHMENT_WRITE)
+            .old_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL)
+            .new_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .image(dst)
+            .subresource_range(range)];
+        let (last_stage, last_access, last_layout) = if overlay.is_some() {
+            (
+                vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
+                vk::AccessFlags2::COLOR_ATTACHMENT_WRITE,
+                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+            )
+        } else {
+            (vk::PipelineStageFlags2::BLIT, vk::AccessFlags2::TRANSFER_WRITE, vk::ImageLayout::TRANSFER_DST_OPTIMAL)
+        };
         // Then to the present layout, before the semaphore the present waits on (signalled at
         // ALL_COMMANDS, which takes in the transition). BOTTOM_OF_PIPE, not ALL_COMMANDS: the
         // same for a barrier with no later access, without the best-practices layer's warning.
         let to_present = [vk::ImageMemoryBarrier2::default()
-            .src_stage_mask(vk::PipelineStageFlags2::BLIT)
-            .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+            .src_stage_mask(last_stage)
+            .src_access_mask(last_access)
             .dst_stage_mask(vk::PipelineStageFlags2::BOTTOM_OF_PIPE)
             .dst_access_mask(vk::AccessFlags2::NONE)
-            .old_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL)
+            .old_layout(last_layout)
             .new_layout(vk::ImageLayout::PRESENT_SRC_KHR)
             .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
             .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
@@ -718,7 +746,29 @@ impl<'a> Recorder<'a> {
                 &region,
                 vk::Filter::LINEAR,
             );
-            device.cmd_pipeline_barrier2(self.cmd, &vk::DependencyInfo::default().image_memory_barriers(&to_present));
+        }
+        if let Some((overlay, frame)) = overlay {
+            let attachment = [vk::RenderingAttachmentInfo::default()
+                .image_view(dst_view)
+                .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+                .load_op(vk::AttachmentLoadOp::LOAD)
+                .store_op(vk::AttachmentStoreOp::STORE)];
+            let area = vk::Rect2D { offset: vk::Offset2D::default(), extent: dst_extent };
+            let info = vk::RenderingInfo::default().render_area(area).layer_count(1).color_attachments(&attachment);
+            // SAFETY: the image is in COLOR_ATTACHMENT_OPTIMAL (barrier below, before the scope).
+            unsafe {
+                let device = self.device();
+                device
+                    .cmd_pipeline_barrier2(self.cmd, &vk::DependencyInfo::default().image_memory_barriers(&to_overlay));
+                device.cmd_begin_rendering(self.cmd, &info);
+            }
+            let drawn = overlay.record(self.cmd, dst_extent, frame);
+            unsafe { self.device().cmd_end_rendering(self.cmd) };
+            drawn?;
+        }
+        unsafe {
+            self.device()
+                .cmd_pipeline_barrier2(self.cmd, &vk::DependencyInfo::default().image_memory_barriers(&to_present));
         }
         Ok(())
     }

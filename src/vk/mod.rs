@@ -4,6 +4,7 @@
 
 mod commands;
 mod context;
+mod overlay;
 mod pipeline;
 mod profiler;
 mod resources;
@@ -12,6 +13,7 @@ mod swapchain;
 pub use ash::vk::{BufferUsageFlags, CullModeFlags, Extent2D, Format, ImageUsageFlags, PrimitiveTopology};
 pub use commands::{Bind, Recorder};
 pub use context::{list_devices, Context, ContextOptions, DeviceInfo, ValidationCounts};
+pub use overlay::{Overlay, OverlayFrame};
 pub use pipeline::{check_all_shaders, BindingKind, GraphicsDesc, Pipeline};
 pub use profiler::{GpuProfiler, TimedScope};
 pub use resources::{Access, Buffer, Image, MemoryLocation, Sampler};

@@ -75,6 +75,8 @@ pub struct Presenter {
     surface: vk::SurfaceKHR,
     swapchain: vk::SwapchainKHR,
     images: Vec<vk::Image>,
+    /// Colour views of the images, for the overlay's drawing.
+    views: Vec<vk::ImageView>,
     /// One per swapchain image, not per slot: nothing says when a present has finished waiting on
     /// its semaphore, but the image's next acquire does.
     render_finished: Vec<vk::Semaphore>,
@@ -116,6 +118,7 @@ impl Presenter {
             surface,
             swapchain: vk::SwapchainKHR::null(),
             images: Vec::new(),
+            views: Vec::new(),
             render_finished: Vec::new(),
             format: vk::SurfaceFormatKHR::default(),
             present_mode: vk::PresentModeKHR::FIFO,
@@ -235,6 +238,7 @@ impl Presenter {
         ctx: &Context,
         source: &Image,
         before: impl FnOnce(&mut Recorder) -> Result<()>,
+        overlay: Option<(&mut super::overlay::Overlay, &super::overlay::OverlayFrame)>,
     ) -> Result<Presented> {
         if self.window_size.width == 0 || self.window_size.height == 0 {
             return Ok(Presented::Skipped);
@@ -263,10 +267,11 @@ impl Presenter {
             }
             Err(e) => return Err(runtime!("vkAcquireNextImageKHR: {e}")),
         };
-        let (image, extent, finished) = (self.images[index], self.extent, self.render_finished[index]);
+        let (image, view, extent, finished) =
+            (self.images[index], self.views[index], self.extent, self.render_finished[index]);
         ctx.submit_presentation(slot.pool, slot.cmd, slot.fence, slot.image_available, finished, |rec| {
             before(rec)?;
-            rec.blit_to_swapchain(source, image, extent)
+            rec.blit_to_swapchain(source, image, view, extent, overlay)
         })?;
         self.next_slot = (self.next_slot + 1) % self.slots.len();
         let waits = [finished];
@@ -301,8 +306,9 @@ impl Presenter {
         if extent.width == 0 || extent.height == 0 {
             return Ok(false);
         }
-        if !caps.supported_usage_flags.contains(vk::ImageUsageFlags::TRANSFER_DST) {
-            return Err(runtime!("the window's swapchain images cannot be transfer destinations"));
+        let usage = vk::ImageUsageFlags::TRANSFER_DST | vk::ImageUsageFlags::COLOR_ATTACHMENT;
+        if !caps.supported_usage_flags.contains(usage) {
+            return Err(runtime!("the window's swapchain images cannot be blitted to and drawn on"));
         }
         // Everything that used the old swapchain and its semaphores must be done before they go.
         ctx.wait_idle()?;
@@ -327,7 +333,7 @@ impl Presenter {
             .image_color_space(self.format.color_space)
             .image_extent(extent)
             .image_array_layers(1)
-            .image_usage(vk::ImageUsageFlags::TRANSFER_DST)
+            .image_usage(usage)
             .image_sharing_mode(vk::SharingMode::EXCLUSIVE)
             .pre_transform(caps.current_transform)
             .composite_alpha(alpha)
@@ -344,11 +350,29 @@ impl Presenter {
             for s in self.render_finished.drain(..) {
                 self.shared.device.destroy_semaphore(s, None);
             }
+            for v in self.views.drain(..) {
+                self.shared.device.destroy_image_view(v, None);
+            }
         }
         self.swapchain = swapchain;
         self.images = unsafe { self.swapchain_loader.get_swapchain_images(swapchain) }
             .map_err(|e| runtime!("vkGetSwapchainImagesKHR: {e}"))?;
-        for _ in 0..self.images.len() {
+        for &image in &self.images {
+            let info = vk::ImageViewCreateInfo::default()
+                .image(image)
+                .view_type(vk::ImageViewType::TYPE_2D)
+                .format(self.format.format)
+                .subresource_range(vk::ImageSubresourceRange {
+                    aspect_mask: vk::ImageAspectFlags::COLOR,
+                    base_mip_level: 0,
+                    level_count: 1,
+                    base_array_layer: 0,
+                    layer_count: 1,
+                });
+            // SAFETY: a swapchain image of this device; destroyed before the swapchain.
+            let view = unsafe { self.shared.device.create_image_view(&info, None) }
+                .map_err(|e| runtime!("vkCreateImageView: {e}"))?;
+            self.views.push(view);
             let s = unsafe { self.shared.device.create_semaphore(&vk::SemaphoreCreateInfo::default(), None) }
                 .map_err(|e| runtime!("vkCreateSemaphore: {e}"))?;
             self.render_finished.push(s);
@@ -381,6 +405,9 @@ impl Drop for Presenter {
             }
             for s in self.render_finished.drain(..) {
                 device.destroy_semaphore(s, None);
+            }
+            for v in self.views.drain(..) {
+                device.destroy_image_view(v, None);
             }
             if self.swapchain != vk::SwapchainKHR::null() {
                 self.swapchain_loader.destroy_swapchain(self.swapchain, None);
