@@ -72,12 +72,29 @@ fn open_resize_minimise_and_close_are_clean() {
     if !have_xvfb() {
         return;
     }
+    let trace = output_dir().join("view-trace.json");
+    let _ = std::fs::remove_file(&trace);
+    let trace_line = format!("trace 2 {}", trace.display());
     let out = view(
         "resize",
         SCENE,
-        &["frames 2", "resize 128 80", "frames 2", "resize 0 0", "frames 2", "resize 96 112", "frames 1", "quit"],
+        &[
+            &trace_line,
+            "frames 2",
+            "resize 128 80",
+            "frames 2",
+            "resize 0 0",
+            "frames 2",
+            "resize 96 112",
+            "frames 1",
+            "quit",
+        ],
     );
     assert_ok("resize", &out);
+    // The trace of the first two frames: Chrome trace events with the frame's passes.
+    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&trace).unwrap()).unwrap();
+    let text = json.to_string();
+    assert!(text.contains("tree build") && text.contains("shade"), "{text}");
 }
 
 #[test]

@@ -720,6 +720,8 @@ impl Viewer {
                 self.update_subsurface()?;
             }
             Action::Set(setting) => {
+                // Kept to go back to when the change is refused (e.g. g ≥ 1 typed on the panel).
+                let before = (self.subsurface.material.clone(), self.subsurface.epsilon, self.subsurface.roughness);
                 let s = &mut self.subsurface;
                 match setting {
                     Setting::Epsilon(e) => s.epsilon = e,
@@ -739,8 +741,10 @@ impl Viewer {
                     Setting::Samples(n) => self.renderer.set_point_count(n, &self.scene.mesh)?,
                     Setting::Show(show) => self.renderer.set_show(show),
                 }
-                self.subsurface.material.validate()?;
-                self.update_subsurface()?;
+                if let Err(e) = self.subsurface.material.validate().and_then(|_| self.update_subsurface()) {
+                    (self.subsurface.material, self.subsurface.epsilon, self.subsurface.roughness) = before;
+                    return Err(e);
+                }
             }
             Action::Frames(n) => self.script_frames = n,
             Action::Screenshot(path) => {
@@ -823,9 +827,12 @@ impl Viewer {
     /// One turn of the loop: script lines, then a step of a frame (a preview or a full one), or a
     /// present of the last frame.
     fn step(&mut self) -> Result<()> {
-        // The panel's changes of the last present, for this frame.
+        // The panel's changes of the last present, for this frame. One it refuses is reported
+        // and left out; the viewer goes on.
         for action in std::mem::take(&mut self.pending_actions) {
-            self.apply(action)?;
+            if let Err(e) = self.apply(action) {
+                eprintln!("warning: panel: {e}");
+            }
         }
         self.run_script()?;
         if self.quit {

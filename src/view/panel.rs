@@ -1,7 +1,7 @@
 //! The viewer's panel (egui): the settings, each change an [`Action`] applied after the frame
 //! (so it takes effect on the next one), and the timings of the last frames.
 
-use egui::{Color32, RichText};
+use egui::{Color32, RichText, SliderClamping::Edits};
 
 use super::controls::{Action, Setting};
 use crate::frame::Show;
@@ -52,8 +52,14 @@ pub fn draw(ctx: &egui::Context, s: &PanelState, actions: &mut Vec<Action>) {
                     ui.label(label);
                     for (c, value) in v.iter_mut().enumerate() {
                         let colour = [Color32::LIGHT_RED, Color32::LIGHT_GREEN, Color32::LIGHT_BLUE][c];
-                        ui.add(egui::DragValue::new(value).speed(speed).range(0.0..=max).max_decimals(4))
-                            .on_hover_text(RichText::new(["red", "green", "blue"][c]).color(colour));
+                        ui.add(
+                            egui::DragValue::new(value)
+                                .speed(speed)
+                                .range(0.0..=max)
+                                .clamp_existing_to_range(false)
+                                .max_decimals(4),
+                        )
+                        .on_hover_text(RichText::new(["red", "green", "blue"][c]).color(colour));
                     }
                 });
                 (v != values).then_some(v)
@@ -67,13 +73,13 @@ pub fn draw(ctx: &egui::Context, s: &PanelState, actions: &mut Vec<Action>) {
             if let Some(v) = per_channel(ui, "σ's [1/mm]", reduced, 0.01, 1000.0) {
                 actions.push(Action::Set(Setting::SigmaS([0, 1, 2].map(|c| v[c] / (1.0 - m.g[c]).max(1e-6)))));
             }
-            if let Some(v) = per_channel(ui, "g", m.g, 0.01, 0.99) {
+            if let Some(v) = per_channel(ui, "g", m.g, 0.01, 0.999) {
                 actions.push(Action::Set(Setting::G(v)));
             }
             let mut eta = m.eta;
             ui.horizontal(|ui| {
                 ui.label("η");
-                ui.add(egui::DragValue::new(&mut eta).speed(0.01).range(1.0..=3.0));
+                ui.add(egui::DragValue::new(&mut eta).speed(0.01).range(1.0..=3.0).clamp_existing_to_range(false));
             });
             if eta != m.eta {
                 actions.push(Action::Set(Setting::Eta(eta)));
@@ -89,12 +95,18 @@ pub fn draw(ctx: &egui::Context, s: &PanelState, actions: &mut Vec<Action>) {
                 actions.push(Action::Set(Setting::Model(model)));
             }
             let mut epsilon = s.epsilon;
-            ui.add(egui::Slider::new(&mut epsilon, 0.005..=1.0).logarithmic(true).text("ε"));
+            ui.add(egui::Slider::new(&mut epsilon, 0.005..=1.0).logarithmic(true).clamping(Edits).text("ε"));
             if epsilon != s.epsilon {
                 actions.push(Action::Set(Setting::Epsilon(epsilon)));
             }
             let mut samples = s.samples;
-            let response = ui.add(egui::DragValue::new(&mut samples).speed(64).range(2..=1 << 20).prefix("samples "));
+            let response = ui.add(
+                egui::DragValue::new(&mut samples)
+                    .speed(64)
+                    .range(2..=1 << 20)
+                    .clamp_existing_to_range(false)
+                    .prefix("samples "),
+            );
             // A new hierarchy per change: only once the drag ends.
             if samples != s.samples && !response.dragged() {
                 actions.push(Action::Set(Setting::Samples(samples)));
@@ -103,7 +115,7 @@ pub fn draw(ctx: &egui::Context, s: &PanelState, actions: &mut Vec<Action>) {
             let mut stops = s.exposure.unwrap_or(0.0);
             ui.horizontal(|ui| {
                 ui.checkbox(&mut auto, "auto exposure");
-                ui.add_enabled(!auto, egui::Slider::new(&mut stops, -8.0..=8.0).text("stops"));
+                ui.add_enabled(!auto, egui::Slider::new(&mut stops, -8.0..=8.0).clamping(Edits).text("stops"));
             });
             let exposure = (!auto).then_some(stops);
             if exposure != s.exposure {
@@ -112,7 +124,10 @@ pub fn draw(ctx: &egui::Context, s: &PanelState, actions: &mut Vec<Action>) {
             let (mut specular, mut roughness) = (s.specular, s.roughness);
             ui.horizontal(|ui| {
                 ui.checkbox(&mut specular, "specular");
-                ui.add_enabled(specular, egui::Slider::new(&mut roughness, 0.02..=1.0).text("roughness"));
+                ui.add_enabled(
+                    specular,
+                    egui::Slider::new(&mut roughness, 0.02..=1.0).clamping(Edits).text("roughness"),
+                );
             });
             if specular != s.specular {
                 actions.push(Action::Set(Setting::Specular(specular)));
@@ -132,7 +147,7 @@ pub fn draw(ctx: &egui::Context, s: &PanelState, actions: &mut Vec<Action>) {
                 let level = if let Show::Tree(l) = s.show { l } else { 4 };
                 ui.radio_value(&mut show, Show::Tree(level), "tree");
                 if let Show::Tree(l) = &mut show {
-                    ui.add(egui::DragValue::new(l).range(0..=24).prefix("level "));
+                    ui.add(egui::DragValue::new(l).range(0..=24).clamp_existing_to_range(false).prefix("level "));
                 }
             });
             if show != s.show {
@@ -165,4 +180,54 @@ pub fn draw(ctx: &egui::Context, s: &PanelState, actions: &mut Vec<Action>) {
             ui.label("keys: t writes a trace of 10 frames, p a screenshot, h hides this panel");
         });
     });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn state(material: crate::materials::Material) -> PanelState {
+        PanelState {
+            material,
+            model: Model::Directional,
+            epsilon: 0.1,
+            samples: 4096,
+            exposure: None,
+            specular: true,
+            roughness: 0.35,
+            brute_force: false,
+            show: Show::Tree(3),
+            playing: Some(true),
+            device: "test".into(),
+            last_frame: "96x96 refined in 1 ms".into(),
+            fps: 1.0,
+            work_per_pixel: Some((10.0, 2.0)),
+            passes: vec![("shade".into(), 1.0)],
+            refining: Some(0.5),
+        }
+    }
+
+    #[test]
+    fn an_untouched_panel_changes_nothing() {
+        // A spurious action (a value rounded or clamped by a widget) would re-render forever.
+        let ctx = egui::Context::default();
+        let mut unusual = state(crate::materials::Material::find("marble").unwrap());
+        // Values the widgets' ranges do not cover, as the command line may set them.
+        (unusual.epsilon, unusual.roughness, unusual.exposure, unusual.samples) = (0.0, 0.01, Some(12.0), 1 << 21);
+        unusual.show = Show::Tree(40);
+        unusual.material.eta = 0.8;
+        let states = crate::materials::Material::presets().into_iter().map(state).chain([unusual]);
+        for s in states {
+            let material = s.material.clone();
+            for _ in 0..3 {
+                let mut actions = Vec::new();
+                let input = egui::RawInput {
+                    screen_rect: Some(egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(800.0, 900.0))),
+                    ..Default::default()
+                };
+                let _ = ctx.run_ui(input, |ui| draw(ui.ctx(), &s, &mut actions));
+                assert!(actions.is_empty(), "{}: {actions:?}", material.name);
+            }
+        }
+    }
 }
