@@ -207,6 +207,46 @@ mod tests {
         }
     }
 
+    /// Where the panel drew a text containing `needle` (searching egui's output shapes).
+    fn text_position(shapes: &[egui::epaint::ClippedShape], needle: &str) -> Option<egui::Pos2> {
+        fn find(shape: &egui::Shape, needle: &str) -> Option<egui::Pos2> {
+            match shape {
+                egui::Shape::Text(t) if t.galley.text().contains(needle) => {
+                    Some(t.pos + t.galley.rect.center().to_vec2())
+                }
+                egui::Shape::Vec(v) => v.iter().find_map(|s| find(s, needle)),
+                _ => None,
+            }
+        }
+        shapes.iter().find_map(|c| find(&c.shape, needle))
+    }
+
+    #[test]
+    fn clicking_the_brute_force_box_asks_for_brute_force() {
+        let ctx = egui::Context::default();
+        let s = state(crate::materials::Material::find("skin1").unwrap());
+        let screen = Some(egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(800.0, 900.0)));
+        let frame = |events: Vec<egui::Event>| {
+            let mut actions = Vec::new();
+            let input = egui::RawInput { screen_rect: screen, events, ..Default::default() };
+            let output = ctx.run_ui(input, |ui| draw(ui.ctx(), &s, &mut actions));
+            (output, actions)
+        };
+        // egui lays a new window out over a first, invisible pass.
+        frame(Vec::new());
+        let (output, _) = frame(Vec::new());
+        let at = text_position(&output.shapes, "brute force").expect("the brute force box is drawn");
+        let button = |pressed| egui::Event::PointerButton {
+            pos: at,
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers: Default::default(),
+        };
+        frame(vec![egui::Event::PointerMoved(at), button(true)]);
+        let (_, actions) = frame(vec![button(false)]);
+        assert_eq!(actions, vec![Action::Set(Setting::BruteForce(true))]);
+    }
+
     #[test]
     fn an_untouched_panel_changes_nothing() {
         // A spurious action (a value rounded or clamped by a widget) would re-render forever.
