@@ -171,6 +171,41 @@ fn scripted_orbit_changes_the_image_and_orbiting_back_returns_it() {
 }
 
 #[test]
+fn dragging_shows_previews_then_the_refined_frame() {
+    if !have_xvfb() {
+        return;
+    }
+    let _one_at_a_time = XVFB.lock().unwrap_or_else(|e| e.into_inner());
+    let (a, c) = (png("drag-a"), png("drag-c"));
+    let script = output_dir().join("drag.script");
+    let lines = [
+        format!("screenshot {}", a.display()),
+        // As the mouse drags: interaction, so the frames right after are previews.
+        "drag orbit -100 0".into(),
+        "frames 2".into(),
+        "drag orbit 100 0".into(),
+        "frames 1".into(),
+        format!("screenshot {}", c.display()),
+        "quit".into(),
+    ];
+    std::fs::write(&script, lines.join("\n")).unwrap();
+    let mut args = SCENE.to_vec();
+    args.extend_from_slice(&["--light-dir", "1,0.3,0.2", "--script", script.to_str().unwrap()]);
+    let out = Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 640x480x24", env!("CARGO_BIN_EXE_translucent"), "view", "--validation"])
+        .args(&args)
+        .env("RUST_LOG", "translucent::view=info")
+        .output()
+        .expect("run xvfb-run");
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(0), "stderr:\n{err}");
+    assert!(!err.contains("vulkan validation"), "validation messages:\n{err}");
+    assert!(err.contains("preview frame 24x24"), "no preview at a quarter of 96x96:\n{err}");
+    let back = output::compare(&load(&a), &load(&c)).unwrap();
+    assert!(back.rmse < 1.0, "dragged there and back, refined: {back:?}");
+}
+
+#[test]
 fn material_switch_changes_the_colour_balance_as_the_presets_predict() {
     if !have_xvfb() {
         return;

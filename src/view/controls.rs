@@ -36,6 +36,9 @@ pub enum Action {
     /// A material preset by name.
     Material(String),
     Set(Setting),
+    /// A mouse drag of this many pixels, as the hands make it: it counts as interaction, so the
+    /// frames that follow are previews until the view is still.
+    Drag(Drag, f32, f32),
     /// Render and present this many frames before the next line (skipped frames count while the
     /// window is minimised).
     Frames(u32),
@@ -48,6 +51,14 @@ pub enum Action {
     /// Write a Chrome trace of the GPU timings of the next this many frames.
     Trace(u32, PathBuf),
     Quit,
+}
+
+/// What a mouse drag moves.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Drag {
+    Orbit,
+    Pan,
+    Light,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -233,6 +244,16 @@ pub fn parse_line(line: &str) -> std::result::Result<Action, String> {
                 }
             })
         }
+        "drag" => {
+            want(3, "drag orbit|pan|light DX DY (pixels)")?;
+            let kind = match args[0] {
+                "orbit" => Drag::Orbit,
+                "pan" => Drag::Pan,
+                "light" => Drag::Light,
+                other => return Err(format!("drag '{other}': orbit, pan or light")),
+            };
+            Action::Drag(kind, number(args[1])?, number(args[2])?)
+        }
         "frames" => {
             want(1, "frames N")?;
             Action::Frames(count(args[0])?)
@@ -262,7 +283,7 @@ pub fn parse_line(line: &str) -> std::result::Result<Action, String> {
             Action::Quit
         }
         other => return Err(format!(
-            "unknown command '{other}' (orbit, pan, zoom, light, material, set, frames, screenshot, resize, pause, trace, quit)"
+            "unknown command '{other}' (orbit, pan, zoom, light, drag, material, set, frames, screenshot, resize, pause, trace, quit)"
         )),
     };
     Ok(action)

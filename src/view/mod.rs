@@ -30,7 +30,7 @@ use crate::output::Exposure;
 use crate::scene::Scene;
 use crate::vk::{self, Context, Image, ImageUsageFlags, PresentMode, Presented, Presenter, TimedScope};
 use crate::{bad_input, runtime};
-use controls::{Action, ScriptLine, Setting};
+use controls::{Action, Drag, ScriptLine, Setting};
 
 #[derive(Args, Debug)]
 pub struct ViewArgs {
@@ -606,22 +606,34 @@ impl Viewer {
         let Some((px, py)) = previous else { return };
         let (dx, dy) = ((x - px) as f32, (y - py) as f32);
         let (b, m) = (&self.input.buttons, self.input.modifiers);
-        let action = if b.contains(&MouseButton::Left) && m.control_key() {
-            Action::TurnLights { right_deg: dx * DEGREES_PER_PIXEL, up_deg: -dy * DEGREES_PER_PIXEL }
+        let kind = if b.contains(&MouseButton::Left) && m.control_key() {
+            Drag::Light
         } else if b.contains(&MouseButton::Middle)
             || b.contains(&MouseButton::Right)
             || (b.contains(&MouseButton::Left) && m.shift_key())
         {
-            let h = self.size.1.max(1) as f32;
-            Action::Pan { right: -dx / h, up: dy / h }
+            Drag::Pan
         } else if b.contains(&MouseButton::Left) {
-            Action::Orbit { right_deg: -dx * DEGREES_PER_PIXEL, up_deg: dy * DEGREES_PER_PIXEL }
+            Drag::Orbit
         } else {
             return;
         };
-        if let Err(e) = self.interact(action) {
+        if let Err(e) = self.drag(kind, dx, dy) {
             log::error!("{e}");
         }
+    }
+
+    /// A mouse drag of `dx`, `dy` pixels, from the mouse or a script's `drag` line.
+    fn drag(&mut self, kind: Drag, dx: f32, dy: f32) -> Result<()> {
+        let action = match kind {
+            Drag::Light => Action::TurnLights { right_deg: dx * DEGREES_PER_PIXEL, up_deg: -dy * DEGREES_PER_PIXEL },
+            Drag::Pan => {
+                let h = self.size.1.max(1) as f32;
+                Action::Pan { right: -dx / h, up: dy / h }
+            }
+            Drag::Orbit => Action::Orbit { right_deg: -dx * DEGREES_PER_PIXEL, up_deg: dy * DEGREES_PER_PIXEL },
+        };
+        self.interact(action)
     }
 
     fn key(&mut self, key: &Key) -> Result<()> {
@@ -747,6 +759,7 @@ impl Viewer {
                 }
             }
             Action::Frames(n) => self.script_frames = n,
+            Action::Drag(kind, dx, dy) => self.drag(kind, dx, dy)?,
             Action::Screenshot(path) => {
                 self.refine_now()?;
                 self.renderer.write_image(&path)?;
