@@ -105,10 +105,13 @@ fn frames_flag_exits_after_that_many_frames_with_the_layer_forced_from_outside()
     let _one_at_a_time = XVFB.lock().unwrap_or_else(|e| e.into_inner());
     let shot = png("frames");
     let _ = std::fs::remove_file(&shot);
+    // A resize and a minimise between the frames: swapchains rebuilt under the forced layer too.
+    let script = output_dir().join("frames.script");
+    std::fs::write(&script, "frames 1\nresize 120 90\nframes 1\nresize 0 0\nframes 1\nresize 96 96\n").unwrap();
     let out = Command::new("xvfb-run")
         .args(["-a", "-s", "-screen 0 640x480x24", env!("CARGO_BIN_EXE_translucent"), "view"])
         .args(SCENE)
-        .args(["--frames", "3", "--screenshot", shot.to_str().unwrap()])
+        .args(["--frames", "3", "--screenshot", shot.to_str().unwrap(), "--script", script.to_str().unwrap()])
         .env("VK_INSTANCE_LAYERS", "VK_LAYER_KHRONOS_validation")
         .env(
             "VK_LAYER_ENABLES",
