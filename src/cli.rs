@@ -9,7 +9,7 @@ use crate::error::Result;
 use crate::frame::{FrameOptions, Renderer, Show, SubsurfaceOptions};
 use crate::hierarchy::HierarchyOptions;
 use crate::materials::Material;
-use crate::mesh::{safe_normalize, Mesh};
+use crate::mesh::safe_normalize;
 use crate::output::Exposure;
 use crate::physics::{Diffusion, Model};
 use crate::scene::{Camera, Light, Scene};
@@ -37,6 +37,8 @@ pub enum Command {
     Profile(Box<ProfileArgs>),
     /// Time every pass (GPU timestamps) for several sample counts and meshes; prints Markdown.
     Bench(BenchArgs),
+    /// Show the scene in a window: orbit camera, light and material edits, scripted runs.
+    View(Box<crate::view::ViewArgs>),
 }
 
 #[derive(Args, Debug)]
@@ -210,7 +212,8 @@ impl DeviceArgs {
 #[derive(Args, Debug)]
 pub struct RenderArgs {
     /// Mesh: `sphere`, `box`, `slab`, `torus`, or the path of an OBJ file (default: the Stanford
-    /// bunny from glmark2-data when installed, else the sphere).
+    /// bunny from glmark2-data when installed, else the sphere). A `{frame}` in the path plays a
+    /// sequence of files, one per frame (numbered from 0 or 1, plain or padded to 4 digits).
     #[arg(long)]
     pub mesh: Option<String>,
     /// Output image; the extension picks the format (.png or .exr). A `{frame}` in the name
@@ -229,6 +232,14 @@ pub struct RenderArgs {
     /// centre) every frame: a turntable of light.
     #[arg(long, allow_hyphen_values = true, default_value_t = 0.0, value_parser = finite_f32, value_name = "DEG")]
     pub spin_light: f32,
+    /// Deform the mesh, animated over --deform-period frames (none, full strength, none):
+    /// `twist:DEG` (about the vertical axis, growing with height) or `squash:F` (height × F,
+    /// width / √F). Normals are recomputed every frame.
+    #[arg(long, value_parser = crate::deform::Deformation::parse, value_name = "twist:DEG | squash:F")]
+    pub deform: Option<crate::deform::Deformation>,
+    /// Frames per period of --deform.
+    #[arg(long, default_value_t = 48, value_parser = clap::value_parser!(u32).range(1..))]
+    pub deform_period: u32,
     /// Millimetres per scene unit (materials are given per mm).
     #[arg(long, allow_hyphen_values = true, default_value_t = 10.0, value_parser = positive_f32)]
     pub scale: f32,
@@ -317,7 +328,7 @@ fn triple(s: &str) -> std::result::Result<[f64; 3], String> {
     }
 }
 
-fn light_spec(s: &str) -> std::result::Result<Light, String> {
+pub(crate) fn light_spec(s: &str) -> std::result::Result<Light, String> {
     let mut parts = s.splitn(3, ':');
     let kind = parts.next().unwrap_or("");
     let at = parts.next().ok_or_else(|| format!("'{s}': expected dir:X,Y,Z[:I] or point:X,Y,Z[:I]"))?;
@@ -385,6 +396,7 @@ pub fn run(cli: Cli) -> Result<i32> {
         }
         Command::Bssrdf(args) => bssrdf(&args),
         Command::Profile(args) => profile(&args),
+        Command::View(args) => crate::view::run(&args),
         Command::Bench(args) => {
             let bunny = BUNNY;
             let meshes = args.meshes.clone().unwrap_or_else(|| {
@@ -554,7 +566,7 @@ pub fn mesh_spec(args: &RenderArgs) -> String {
 }
 
 pub fn build_scene(args: &RenderArgs) -> Result<Scene> {
-    let mesh = Mesh::from_spec(&mesh_spec(args))?;
+    let mesh = crate::deform::first_mesh(&mesh_spec(args))?;
     let (centre, radius) = crate::scene::bounding_sphere(&mesh.positions);
     // The object's size in millimetres must stay where f32 areas and powers are finite.
     let size_mm = 2.0 * radius as f64 * args.scale as f64;
@@ -740,12 +752,18 @@ fn render(args: &RenderArgs) -> Result<i32> {
     renderer.progress = Some(bar.clone());
 
     let every_frame = args.out.to_string_lossy().contains("{frame}");
+    let animation =
+        crate::deform::Animation::new(&mesh_spec(args), &scene.mesh, args.deform, args.deform_period, args.up)?;
     let base_lights = scene.lights.clone();
     let (centre, _) = crate::scene::bounding_sphere(&scene.mesh.positions);
     let mut frames = Vec::new();
     for index in 0..args.frames {
         let angle = (args.spin_light * index as f32).to_radians();
         scene.lights = base_lights.iter().map(|l| l.rotated(args.up, angle, centre)).collect();
+        if let Some(animation) = animation.as_ref().filter(|_| index > 0) {
+            scene.mesh = animation.mesh(index)?;
+            renderer.set_mesh(&scene.mesh)?;
+        }
         frames.push(renderer.render_frame(&scene)?);
         if every_frame {
             let path = frame_path(&args.out, index);
@@ -786,7 +804,7 @@ fn render(args: &RenderArgs) -> Result<i32> {
 /// Sample count from the material's shortest length scale (mean free path 1/σ't or diffusion
 /// length 1/σtr) and the mesh's area (in mm), within a budget; prints the choice and warns when
 /// points are farther apart than that length.
-fn default_point_count(ctx: &Context, scene: &Scene, material: &Material) -> u32 {
+pub(crate) fn default_point_count(ctx: &Context, scene: &Scene, material: &Material) -> u32 {
     let mm = scene.mm_per_unit;
     let area_mm2 = scene.mesh.surface_area() * mm * mm;
     let shortest = (0..3)

@@ -17,20 +17,21 @@ use crate::vk::{
 };
 
 /// Shading units for the next submission after `batch` units took `seconds`: as many as fit in
-/// SUBMISSION_TARGET_S at that pace, growing at most ×2 per step, within [1, MAX_UNITS_PER_SUBMISSION].
-fn next_batch_size(batch: usize, seconds: f64) -> usize {
+/// `target` seconds (SUBMISSION_TARGET_S unless set) at that pace, growing at most ×2 per step,
+/// within [1, MAX_UNITS_PER_SUBMISSION].
+fn next_batch_size(batch: usize, seconds: f64, target: f64) -> usize {
     let per_unit = seconds / batch.max(1) as f64;
-    let fit = (SUBMISSION_TARGET_S / per_unit.max(1e-9)).floor() as usize;
+    let fit = (target / per_unit.max(1e-9)).floor() as usize;
     fit.clamp(1, (2 * batch).clamp(1, MAX_UNITS_PER_SUBMISSION))
 }
 
 /// Whether the next frame shades the whole image as one tile: once a frame's shading took one
-/// submission of under a quarter of SUBMISSION_TARGET_S, and for as long as it stays under the target.
-fn shade_whole_frame(whole_frame: bool, submissions: usize, seconds: f64) -> bool {
+/// submission of under a quarter of the `target` time, and for as long as it stays under the target.
+fn shade_whole_frame(whole_frame: bool, submissions: usize, seconds: f64, target: f64) -> bool {
     if whole_frame {
-        seconds < SUBMISSION_TARGET_S
+        seconds < target
     } else {
-        submissions == 1 && seconds < SUBMISSION_TARGET_S / 4.0
+        submissions == 1 && seconds < target / 4.0
     }
 }
 
@@ -59,6 +60,54 @@ fn subsurface_params(o: &SubsurfaceOptions, mm_per_unit: f32, point_count: u32) 
 /// and 0.2–0.4% front-lit, unbiased, at about the cost 0.1 had with one source per node (0.65%,
 /// biased low by 0.6–1.6%). See the sweep in BENCHMARKS.md.
 pub const DEFAULT_EPSILON: f32 = 0.2;
+
+/// The shading inputs, borrowed field by field (a method would borrow all of `self`, and the
+/// profiler is borrowed mutably beside them).
+macro_rules! shade_inputs {
+    ($r:expr) => {
+        ShadeInputs {
+            color: &$r.color,
+            depth: &$r.depth,
+            vertices: &$r.vertices,
+            indices: &$r.indices,
+            index_count: $r.index_count,
+            params: &$r.subsurface_params,
+            nodes: &$r.hierarchy.nodes,
+            points: &$r.hierarchy.sorted_points,
+            work: &$r.work_counters,
+            lights: &$r.hierarchy.lights,
+            shadow_map: &$r.hierarchy.shadow_map,
+            shadow_sampler: &$r.hierarchy.shadow_sampler,
+            point_lights: &$r.hierarchy.sorted_point_lights,
+            node_lights: &$r.hierarchy.node_lights,
+        }
+    };
+}
+
+/// A frame between [`Renderer::begin_frame`] and [`Renderer::finish_frame`].
+pub struct FrameInProgress {
+    view_projection: glam::Mat4,
+    constants: ShadeConstants,
+    units: Vec<shade::ShadeUnit>,
+    done: usize,
+    submissions: usize,
+    shading_seconds: f64,
+    /// The longest time a submission took per unit in it.
+    longest_unit_seconds: f64,
+    extent: Extent2D,
+}
+
+impl FrameInProgress {
+    /// The fraction of the shading done, 0 to 1.
+    pub fn progress(&self) -> f32 {
+        self.done as f32 / self.units.len().max(1) as f32
+    }
+
+    /// The longest time one shading unit (tile) took so far, as measured per submission.
+    pub fn longest_unit_seconds(&self) -> f64 {
+        self.longest_unit_seconds
+    }
+}
 
 /// The most timestamp scopes one frame may open (each shading submission opens one).
 const MAX_SCOPES: u32 = 4096;
@@ -133,8 +182,10 @@ pub struct Renderer {
     tile_fixed: bool,
     /// Frames rendered, for the progress bar.
     frames_done: u64,
-    /// Shading units per submission, adapted to SUBMISSION_TARGET_S.
+    /// Shading units per submission, adapted to `submission_target_s`.
     units_per_submission: usize,
+    /// How long one shading submission should take (SUBMISSION_TARGET_S unless set).
+    submission_target_s: f64,
     /// Advanced by one per shading unit done, when set (the CLI sets one on a terminal).
     pub progress: Option<indicatif::ProgressBar>,
     debug_view: DebugViewPass,
@@ -196,32 +247,13 @@ impl Renderer {
             &scene.mesh.indices,
             BufferUsageFlags::INDEX_BUFFER | BufferUsageFlags::STORAGE_BUFFER,
         )?;
-        let color = Image::new_2d(
-            &ctx,
-            "hdr colour",
-            shade::COLOR_FORMAT,
-            extent,
-            1,
-            ImageUsageFlags::COLOR_ATTACHMENT | ImageUsageFlags::TRANSFER_SRC | ImageUsageFlags::STORAGE,
-        )?;
-        let depth =
-            Image::new_2d(&ctx, "depth", shade::DEPTH_FORMAT, extent, 1, ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT)?;
-        let readback_bytes = width as u64 * height as u64 * 16;
-        let readback =
-            Buffer::new(&ctx, "readback", readback_bytes, BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)?;
+        let Targets { color, depth, readback, ldr } = Targets::new(&ctx, extent)?;
         let histogram = Buffer::new(
             &ctx,
             "luminance histogram",
             tonemap::histogram_bytes(),
             BufferUsageFlags::STORAGE_BUFFER | BufferUsageFlags::TRANSFER_DST,
             MemoryLocation::GpuOnly,
-        )?;
-        let ldr = Buffer::new(
-            &ctx,
-            "tone-mapped image",
-            tonemap::ldr_bytes(width, height),
-            BufferUsageFlags::STORAGE_BUFFER,
-            MemoryLocation::GpuToCpu,
         )?;
         let shade = ShadePass::new(&ctx)?;
         let hierarchy = Hierarchy::new(&ctx, &scene.mesh, &scene.lights, &hierarchy)?;
@@ -255,6 +287,7 @@ impl Renderer {
             tile_fixed: false,
             frames_done: 0,
             units_per_submission: 1,
+            submission_target_s: SUBMISSION_TARGET_S,
             progress: None,
             debug_view: DebugViewPass::new(&ctx)?,
             show,
@@ -274,6 +307,95 @@ impl Renderer {
         })
     }
 
+    /// Renders `width` x `height` images from the next frame on (the window's size, or a preview
+    /// of it); only the size-dependent targets are made again.
+    pub fn set_size(&mut self, width: u32, height: u32) -> Result<()> {
+        let max = self.ctx.limits().max_image_dimension2_d;
+        if width == 0 || height == 0 || width > max || height > max {
+            return Err(bad_input!("image size {width}x{height}: width and height must be between 1 and {max}"));
+        }
+        let extent = Extent2D { width, height };
+        if extent == self.extent {
+            return Ok(());
+        }
+        // A window's copy of the last image may still be reading these targets.
+        self.ctx.wait_idle()?;
+        let Targets { color, depth, readback, ldr } = Targets::new(&self.ctx, extent)?;
+        (self.color, self.depth, self.readback, self.ldr, self.extent) = (color, depth, readback, ldr, extent);
+        // Learn again whether a frame of this size fits one submission.
+        if !self.tile_fixed {
+            self.whole_frame = false;
+            self.units_per_submission = 1;
+        }
+        Ok(())
+    }
+
+    /// How long one shading submission should take from now on (a window wants short ones to stay
+    /// responsive; the default suits GPU watchdogs and the progress bar).
+    pub fn set_submission_target(&mut self, seconds: f64) {
+        self.submission_target_s = seconds.max(1e-3);
+    }
+
+    /// The size of the images rendered.
+    pub fn extent(&self) -> Extent2D {
+        self.extent
+    }
+
+    /// Material, model, ε, brute force and specular for the next frame (the work counting set at
+    /// creation is kept). The hierarchy keeps the η it was built with.
+    pub fn set_subsurface(&mut self, subsurface: &SubsurfaceOptions, mm_per_unit: f32) -> Result<()> {
+        if !(subsurface.epsilon.is_finite() && subsurface.epsilon >= 0.0) {
+            return Err(bad_input!("epsilon {}: must be a finite number ≥ 0", subsurface.epsilon));
+        }
+        if !(subsurface.roughness > 0.0 && subsurface.roughness <= 1.0) {
+            return Err(bad_input!("roughness {}: must be in (0, 1]", subsurface.roughness));
+        }
+        let count_work = self.subsurface_params.read::<SubsurfaceParams>(1)?[0].count_work;
+        let mut params = subsurface_params(subsurface, mm_per_unit, self.hierarchy.point_count);
+        params.count_work = count_work;
+        self.subsurface_params.write(0, &[params])?;
+        self.brute_force = subsurface.brute_force;
+        self.hierarchy.set_eta(subsurface.material.eta as f32)
+    }
+
+    /// Samples `point_count` points from the next frame on: a new hierarchy for `mesh` (the
+    /// scene's current mesh) with the same shadow resolution and η.
+    pub fn set_point_count(&mut self, point_count: u32, mesh: &crate::mesh::Mesh) -> Result<()> {
+        if point_count == self.hierarchy.point_count {
+            return Ok(());
+        }
+        self.ctx.wait_idle()?;
+        let options = HierarchyOptions {
+            point_count,
+            shadow_resolution: self.hierarchy.shadow_map.extent.width,
+            eta: self.hierarchy.eta(),
+        };
+        self.hierarchy = Hierarchy::new(&self.ctx, mesh, &self.lights, &options)?;
+        let mut params = self.subsurface_params.read::<SubsurfaceParams>(1)?[0];
+        (params.point_count, params.node_count) = (point_count, point_count - 1);
+        self.subsurface_params.write(0, &[params])
+    }
+
+    pub fn show(&self) -> Show {
+        self.show
+    }
+
+    /// What to draw over the shading from the next frame on.
+    pub fn set_show(&mut self, show: Show) {
+        self.show = show;
+    }
+
+    /// Exposure of the tone-mapped image from the next frame on.
+    pub fn set_exposure(&mut self, exposure: Exposure) {
+        self.exposure = exposure;
+    }
+
+    /// The last frame tone-mapped on the GPU: one packed RGBA8 pixel per u32 (R in the low byte),
+    /// rows of `extent().width`; a transfer source, e.g. for copying into a window's image.
+    pub fn tone_mapped_buffer(&self) -> &Buffer {
+        &self.ldr
+    }
+
     fn units(&self) -> Vec<shade::ShadeUnit> {
         // Brute force sums (point, light) records, in ranges.
         let brute_force_points = self.brute_force.then_some(self.hierarchy.point_count * self.hierarchy.light_count);
@@ -290,6 +412,36 @@ impl Renderer {
         self.whole_frame = false;
     }
 
+    /// Draws `mesh` from the next frame on (a deformed mesh, the next of a sequence): new vertex
+    /// and index buffers, the hierarchy's triangle count, bounds and shadow matrices. The point
+    /// count stays; the points are sampled on the new surface, as every frame.
+    pub fn set_mesh(&mut self, mesh: &crate::mesh::Mesh) -> Result<()> {
+        mesh.validate()?;
+        let index_count = u32::try_from(mesh.indices.len()).map_err(|_| bad_input!("mesh: too many indices"))?;
+        // A window's copy of the last image may still be in flight; nothing else uses the buffers.
+        self.ctx.wait_idle()?;
+        self.vertices = vk::upload_buffer(
+            &self.ctx,
+            "vertices",
+            &mesh.vertex_data(),
+            BufferUsageFlags::VERTEX_BUFFER | BufferUsageFlags::STORAGE_BUFFER,
+        )?;
+        self.indices = vk::upload_buffer(
+            &self.ctx,
+            "indices",
+            &mesh.indices,
+            BufferUsageFlags::INDEX_BUFFER | BufferUsageFlags::STORAGE_BUFFER,
+        )?;
+        self.index_count = index_count;
+        self.bounds = mesh.bounds();
+        self.hierarchy.set_mesh(&self.ctx, mesh, &self.lights)
+    }
+
+    /// The side of the shading tiles in pixels (when not shading whole frames).
+    pub fn tile_size(&self) -> u32 {
+        self.tile
+    }
+
     /// The progress bar's length for `frames` frames (it counts thousandths of a frame).
     pub fn progress_length(frames: u32) -> u64 {
         frames as u64 * 1000
@@ -298,30 +450,38 @@ impl Renderer {
     /// Renders one frame and returns its GPU timestamp scopes (empty without a profiler). The
     /// lights are taken from `scene` every frame, so they may move between frames.
     pub fn render_frame(&mut self, scene: &Scene) -> Result<Vec<TimedScope>> {
+        let mut frame = self.begin_frame(scene)?;
+        while !self.shade_some(&mut frame, None)? {}
+        self.finish_frame(frame)
+    }
+
+    /// The first part of [`render_frame`](Self::render_frame): the hierarchy and the depth
+    /// pre-pass. Shading follows in [`shade_some`](Self::shade_some) steps (a window spreads them
+    /// over turns of its event loop), then [`finish_frame`](Self::finish_frame). A frame may be
+    /// dropped unfinished; every submission has completed when these return.
+    pub fn begin_frame(&mut self, scene: &Scene) -> Result<FrameInProgress> {
         let aspect = self.extent.width as f32 / self.extent.height as f32;
         let view_projection = scene.camera.view_projection(aspect, self.bounds);
         let constants =
             ShadeConstants { view_projection, eye: scene.camera.eye.extend(1.0), point_range: glam::UVec4::ZERO };
         if scene.lights != self.lights {
-            self.hierarchy.set_lights(&scene.mesh, &scene.lights)?;
+            let layers = |lights: &[crate::scene::Light]| crate::budget::FrameSizes::shadow_layers(lights);
+            if scene.lights.len() != self.lights.len() || layers(&scene.lights) != layers(&self.lights) {
+                // Another number of lights (or of point lights): per-light records and shadow
+                // layers are sized at creation, so the hierarchy is made anew.
+                self.ctx.wait_idle()?;
+                let options = HierarchyOptions {
+                    point_count: self.hierarchy.point_count,
+                    shadow_resolution: self.hierarchy.shadow_map.extent.width,
+                    eta: self.hierarchy.eta(),
+                };
+                self.hierarchy = Hierarchy::new(&self.ctx, &scene.mesh, &scene.lights, &options)?;
+            } else {
+                self.hierarchy.set_lights(&scene.mesh, &scene.lights)?;
+            }
             self.lights = scene.lights.clone();
         }
-        let inputs = ShadeInputs {
-            color: &self.color,
-            depth: &self.depth,
-            vertices: &self.vertices,
-            indices: &self.indices,
-            index_count: self.index_count,
-            params: &self.subsurface_params,
-            nodes: &self.hierarchy.nodes,
-            points: &self.hierarchy.sorted_points,
-            work: &self.work_counters,
-            lights: &self.hierarchy.lights,
-            shadow_map: &self.hierarchy.shadow_map,
-            shadow_sampler: &self.hierarchy.shadow_sampler,
-            point_lights: &self.hierarchy.sorted_point_lights,
-            node_lights: &self.hierarchy.node_lights,
-        };
+        let inputs = shade_inputs!(self);
 
         // The frame, in order: the hierarchy (sampling, shadow maps, irradiance, Morton codes,
         // sort, tree build, summaries; each its own scope), the depth pre-pass, shading in
@@ -336,16 +496,45 @@ impl Renderer {
             rec.end_scope();
             Ok(())
         })?;
+        Ok(FrameInProgress {
+            view_projection,
+            constants,
+            // A debug view costs what it draws: no subsurface shading under it (the pre-pass's
+            // depth still hides what is behind the surface).
+            units: if self.show == Show::Shading { self.units() } else { Vec::new() },
+            done: 0,
+            submissions: 0,
+            shading_seconds: 0.0,
+            longest_unit_seconds: 0.0,
+            extent: self.extent,
+        })
+    }
 
+    /// Shading submissions until the frame is shaded, or with a `budget`, until the next one
+    /// would likely overrun it (at least one is made). Returns whether the shading is complete.
+    pub fn shade_some(&mut self, frame: &mut FrameInProgress, budget: Option<std::time::Duration>) -> Result<bool> {
+        if frame.extent != self.extent {
+            return Err(crate::runtime!("a frame begun at one size was continued at another"));
+        }
+        let inputs = shade_inputs!(self);
+        let constants = frame.constants;
+        let started = std::time::Instant::now();
         // Shading in several submissions, so that none runs long (see SUBMISSION_TARGET_S).
-        // A debug view costs what it draws: no subsurface shading under it (the pre-pass's depth
-        // still hides what is behind the surface).
-        let units = if self.show == Show::Shading { self.units() } else { Vec::new() };
-        let mut done = 0;
-        let (mut submissions, mut shading_seconds) = (0, 0.0);
-        while done < units.len() {
-            let batch = &units[done..(done + self.units_per_submission).min(units.len())];
-            let started = std::time::Instant::now();
+        let units = &frame.units;
+        while frame.done < units.len() {
+            let spent = started.elapsed().as_secs_f64();
+            if budget.is_some_and(|b| spent > 0.0 && spent + self.submission_target_s > b.as_secs_f64()) {
+                break;
+            }
+            let mut size = self.units_per_submission;
+            if let Some(b) = budget {
+                // Tiles differ in cost (background ones are cheap): with a budget, no more than
+                // the rest of it fits at the slowest pace seen in this frame.
+                let worst = frame.longest_unit_seconds.max(1e-9);
+                size = size.min((((b.as_secs_f64() - spent) / worst).floor() as usize).max(1));
+            }
+            let batch = &units[frame.done..(frame.done + size).min(units.len())];
+            let submitted = std::time::Instant::now();
             self.ctx.submit(self.profiler.as_mut(), |rec| {
                 rec.begin_scope("shade");
                 for unit in batch {
@@ -354,17 +543,29 @@ impl Renderer {
                 rec.end_scope();
                 Ok(())
             })?;
-            let seconds = started.elapsed().as_secs_f64();
-            done += batch.len();
-            (submissions, shading_seconds) = (submissions + 1, shading_seconds + seconds);
+            let seconds = submitted.elapsed().as_secs_f64();
+            frame.done += batch.len();
+            frame.longest_unit_seconds = frame.longest_unit_seconds.max(seconds / batch.len() as f64);
+            (frame.submissions, frame.shading_seconds) = (frame.submissions + 1, frame.shading_seconds + seconds);
             if let Some(bar) = &self.progress {
-                bar.set_position(self.frames_done * 1000 + (1000 * done / units.len()) as u64);
+                bar.set_position(self.frames_done * 1000 + (1000 * frame.done / units.len()) as u64);
             }
-            self.units_per_submission = next_batch_size(batch.len(), seconds);
+            self.units_per_submission = next_batch_size(batch.len(), seconds, self.submission_target_s);
         }
+        Ok(frame.done == units.len())
+    }
+
+    /// The last part of a frame: debug views, tone mapping and read-back. Returns the frame's GPU
+    /// timestamp scopes (empty without a profiler).
+    pub fn finish_frame(&mut self, frame: FrameInProgress) -> Result<Vec<TimedScope>> {
+        if frame.done < frame.units.len() || frame.extent != self.extent {
+            return Err(crate::runtime!("finish_frame: the frame's shading is not complete"));
+        }
+        let view_projection = frame.view_projection;
         self.frames_done += 1;
         if !self.tile_fixed {
-            self.whole_frame = shade_whole_frame(self.whole_frame, submissions, shading_seconds);
+            self.whole_frame =
+                shade_whole_frame(self.whole_frame, frame.submissions, frame.shading_seconds, self.submission_target_s);
         }
 
         if self.show == Show::Samples {
@@ -468,26 +669,65 @@ impl Renderer {
     }
 }
 
+/// The images and buffers whose size is the frame's.
+struct Targets {
+    color: Image,
+    depth: Image,
+    readback: Buffer,
+    ldr: Buffer,
+}
+
+impl Targets {
+    fn new(ctx: &Context, extent: Extent2D) -> Result<Targets> {
+        let color = Image::new_2d(
+            ctx,
+            "hdr colour",
+            shade::COLOR_FORMAT,
+            extent,
+            1,
+            ImageUsageFlags::COLOR_ATTACHMENT | ImageUsageFlags::TRANSFER_SRC | ImageUsageFlags::STORAGE,
+        )?;
+        let depth =
+            Image::new_2d(ctx, "depth", shade::DEPTH_FORMAT, extent, 1, ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT)?;
+        let readback_bytes = extent.width as u64 * extent.height as u64 * 16;
+        let readback =
+            Buffer::new(ctx, "readback", readback_bytes, BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)?;
+        let ldr = Buffer::new(
+            ctx,
+            "tone-mapped image",
+            tonemap::ldr_bytes(extent.width, extent.height),
+            // TRANSFER_SRC: `view` copies it into the window's image.
+            BufferUsageFlags::STORAGE_BUFFER | BufferUsageFlags::TRANSFER_SRC,
+            MemoryLocation::GpuToCpu,
+        )?;
+        Ok(Targets { color, depth, readback, ldr })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
     fn submissions_grow_and_shrink_toward_the_target_time() {
-        assert_eq!(next_batch_size(1, 1e-6), 2, "fast: at most doubles");
-        assert_eq!(next_batch_size(200, 1e-6), MAX_UNITS_PER_SUBMISSION, "never past the descriptor pool");
-        assert_eq!(next_batch_size(8, 0.1), 16);
-        assert_eq!(next_batch_size(8, 0.8), 2, "slow: shrinks to what fits");
-        assert_eq!(next_batch_size(1, 30.0), 1, "never below one unit");
-        assert_eq!(next_batch_size(4, 0.0), 8);
+        assert_eq!(next_batch_size(1, 1e-6, SUBMISSION_TARGET_S), 2, "fast: at most doubles");
+        assert_eq!(
+            next_batch_size(200, 1e-6, SUBMISSION_TARGET_S),
+            MAX_UNITS_PER_SUBMISSION,
+            "never past the descriptor pool"
+        );
+        assert_eq!(next_batch_size(8, 0.1, SUBMISSION_TARGET_S), 16);
+        assert_eq!(next_batch_size(8, 0.8, SUBMISSION_TARGET_S), 2, "slow: shrinks to what fits");
+        assert_eq!(next_batch_size(1, 30.0, SUBMISSION_TARGET_S), 1, "never below one unit");
+        assert_eq!(next_batch_size(4, 0.0, SUBMISSION_TARGET_S), 8);
     }
 
     #[test]
     fn fast_frames_are_shaded_whole() {
-        assert!(shade_whole_frame(false, 1, 0.01), "one quick submission: one tile next time");
-        assert!(!shade_whole_frame(false, 2, 0.01), "several submissions: keep the tiles");
-        assert!(!shade_whole_frame(false, 1, 0.1), "not quick enough to risk a whole frame");
-        assert!(shade_whole_frame(true, 1, 0.15), "stays whole while under the target");
-        assert!(!shade_whole_frame(true, 1, 0.5), "back to tiles when a frame gets slow");
+        assert!(shade_whole_frame(false, 1, 0.01, SUBMISSION_TARGET_S), "one quick submission: one tile next time");
+        assert!(!shade_whole_frame(false, 2, 0.01, SUBMISSION_TARGET_S), "several submissions: keep the tiles");
+        assert!(!shade_whole_frame(false, 1, 0.1, SUBMISSION_TARGET_S), "not quick enough to risk a whole frame");
+        assert!(shade_whole_frame(true, 1, 0.15, SUBMISSION_TARGET_S), "stays whole while under the target");
+        assert!(!shade_whole_frame(true, 1, 0.5, SUBMISSION_TARGET_S), "back to tiles when a frame gets slow");
     }
 }

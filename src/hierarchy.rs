@@ -400,6 +400,38 @@ impl Hierarchy {
     pub fn bounds(&self) -> (Vec3, Vec3) {
         self.bounds
     }
+
+    pub fn eta(&self) -> f32 {
+        self.eta
+    }
+
+    /// The relative index of refraction used for the light entering the surface (a material
+    /// change); written into the light set at once.
+    pub fn set_eta(&mut self, eta: f32) -> Result<()> {
+        self.eta = eta;
+        self.lights.write(std::mem::offset_of!(LightSetHeader, eta) as u64, &[eta])
+    }
+
+    /// Follows a mesh that changed (deformed, or the next of a sequence): its triangle count,
+    /// its bounds (the Morton codes' box) and the lights' shadow matrices. The point count stays.
+    pub fn set_mesh(&mut self, ctx: &Context, mesh: &Mesh, lights: &[Light]) -> Result<()> {
+        let triangles = mesh.triangle_count() as u32;
+        if triangles != self.triangle_count {
+            self.prefix = Buffer::new(
+                ctx,
+                "triangle area prefix sum",
+                (triangles as u64 + 1) * 4,
+                BufferUsageFlags::STORAGE_BUFFER | BufferUsageFlags::TRANSFER_SRC | BufferUsageFlags::TRANSFER_DST,
+                MemoryLocation::GpuOnly,
+            )?;
+            self.triangle_count = triangles;
+        }
+        self.index_count = mesh.indices.len() as u32;
+        let (lo, hi) = mesh.bounds();
+        let pad = (hi - lo).max_element() * 1e-3;
+        self.bounds = (lo - Vec3::splat(pad), hi + Vec3::splat(pad));
+        self.set_lights(mesh, lights)
+    }
 }
 
 pub struct Snapshot {

@@ -5,6 +5,7 @@ pub mod bench;
 pub mod bssrdf_csv;
 pub mod budget;
 pub mod cli;
+pub mod deform;
 pub mod error;
 pub mod frame;
 pub mod hierarchy;
@@ -17,6 +18,7 @@ pub mod plot;
 pub mod profiling;
 pub mod scene;
 pub mod shaders;
+pub mod view;
 pub mod vk;
 
 pub use error::{Error, Result};

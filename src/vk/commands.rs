@@ -166,6 +166,65 @@ impl Context {
     }
 }
 
+impl Context {
+    /// Records `cmd` (from `pool`, reset first) with `record` and submits it without waiting: it
+    /// waits for `wait` (an acquired swapchain image) before its transfers, signals `signal` (for
+    /// the present) and `fence` (so the caller knows when `cmd` may be recorded again). For
+    /// presentation only: the recorder has no descriptor pool, so it can copy and blit but not
+    /// dispatch or draw.
+    pub(crate) fn submit_presentation(
+        &self,
+        pool: vk::CommandPool,
+        cmd: vk::CommandBuffer,
+        fence: vk::Fence,
+        wait: vk::Semaphore,
+        signal: vk::Semaphore,
+        record: impl FnOnce(&mut Recorder) -> Result<()>,
+    ) -> Result<()> {
+        let device = self.device();
+        // SAFETY: the caller waited for `fence`, so `cmd` is no longer in use.
+        unsafe {
+            device
+                .reset_command_pool(pool, vk::CommandPoolResetFlags::empty())
+                .map_err(|e| runtime!("vkResetCommandPool: {e}"))?;
+            device
+                .begin_command_buffer(
+                    cmd,
+                    &vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
+                )
+                .map_err(|e| runtime!("vkBeginCommandBuffer: {e}"))?;
+        }
+        let mut rec = Recorder {
+            ctx: self,
+            cmd,
+            descriptor_pool: vk::DescriptorPool::null(),
+            profiler: None,
+            inside_rendering: false,
+            open_scopes: Vec::new(),
+        };
+        let result = record(&mut rec);
+        // SAFETY: recording finished (also on error, so the buffer is not left recording).
+        unsafe { device.end_command_buffer(cmd) }.map_err(|e| runtime!("vkEndCommandBuffer: {e}"))?;
+        result?;
+        let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
+        // The swapchain image is first touched by the transfer that clears its layout.
+        let waits =
+            [vk::SemaphoreSubmitInfo::default().semaphore(wait).stage_mask(vk::PipelineStageFlags2::ALL_TRANSFER)];
+        let signals =
+            [vk::SemaphoreSubmitInfo::default().semaphore(signal).stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)];
+        let submit = [vk::SubmitInfo2::default()
+            .command_buffer_infos(&cmds)
+            .wait_semaphore_infos(&waits)
+            .signal_semaphore_infos(&signals)];
+        // SAFETY: the queue is used from this thread only; the fence is reset just before its submission.
+        unsafe {
+            device.reset_fences(&[fence]).map_err(|e| runtime!("vkResetFences: {e}"))?;
+            device.queue_submit2(self.queue, &submit, fence).map_err(|e| runtime!("vkQueueSubmit2: {e}"))?;
+        }
+        Ok(())
+    }
+}
+
 impl<'a> Recorder<'a> {
     fn device(&self) -> &ash::Device {
         self.ctx.device()
@@ -607,6 +666,126 @@ impl<'a> Recorder<'a> {
                 &region,
             )
         };
+        Ok(())
+    }
+
+    /// Scales all of `src` onto all of a swapchain image (not a tracked [`Image`]), whose earlier
+    /// contents are discarded, and leaves it ready to present. Blitting converts between the
+    /// source's RGBA and the swapchain's channel order.
+    pub(crate) fn blit_to_swapchain(
+        &mut self,
+        src: &Image,
+        dst: vk::Image,
+        dst_view: vk::ImageView,
+        dst_extent: vk::Extent2D,
+        overlay: Option<(&mut super::overlay::Overlay, &super::overlay::OverlayFrame)>,
+    ) -> Result<()> {
+        self.use_image(src, Access::TRANSFER_READ)?;
+        let range = vk::ImageSubresourceRange {
+            aspect_mask: vk::ImageAspectFlags::COLOR,
+            base_mip_level: 0,
+            level_count: 1,
+            base_array_layer: 0,
+            layer_count: 1,
+        };
+        // Chained to the acquire semaphore's wait at ALL_TRANSFER: the layout change happens after
+        // the presentation engine has let go of the image.
+        let to_transfer = [vk::ImageMemoryBarrier2::default()
+            .src_stage_mask(vk::PipelineStageFlags2::ALL_TRANSFER)
+            .src_access_mask(vk::AccessFlags2::NONE)
+            .dst_stage_mask(vk::PipelineStageFlags2::BLIT)
+            .dst_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+            .old_layout(vk::ImageLayout::UNDEFINED)
+            .new_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL)
+            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .image(dst)
+            .subresource_range(range)];
+        let layers = vk::ImageSubresourceLayers {
+            aspect_mask: vk::ImageAspectFlags::COLOR,
+            mip_level: 0,
+            base_array_layer: 0,
+            layer_count: 1,
+        };
+        let corner = |e: vk::Extent2D| vk::Offset3D { x: e.width as i32, y: e.height as i32, z: 1 };
+        let region = [vk::ImageBlit {
+            src_subresource: layers,
+            src_offsets: [vk::Offset3D::default(), corner(src.extent)],
+            dst_subresource: layers,
+            dst_offsets: [vk::Offset3D::default(), corner(dst_extent)],
+        }];
+        // With an overlay, the blit's result is drawn over as a colour attachment.
+        let to_overlay = [vk::ImageMemoryBarrier2::default()
+            .src_stage_mask(vk::PipelineStageFlags2::BLIT)
+            .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+            .dst_stage_mask(vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT)
+            .dst_access_mask(vk::AccessFlags2::COLOR_ATTACHMENT_READ | vk::AccessFlags2::COLOR_ATTACHMENT_WRITE)
+            .old_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL)
+            .new_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .image(dst)
+            .subresource_range(range)];
+        let (last_stage, last_access, last_layout) = if overlay.is_some() {
+            (
+                vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
+                vk::AccessFlags2::COLOR_ATTACHMENT_WRITE,
+                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+            )
+        } else {
+            (vk::PipelineStageFlags2::BLIT, vk::AccessFlags2::TRANSFER_WRITE, vk::ImageLayout::TRANSFER_DST_OPTIMAL)
+        };
+        // Then to the present layout, before the semaphore the present waits on (signalled at
+        // ALL_COMMANDS, which takes in the transition). BOTTOM_OF_PIPE, not ALL_COMMANDS: the
+        // same for a barrier with no later access, without the best-practices layer's warning.
+        let to_present = [vk::ImageMemoryBarrier2::default()
+            .src_stage_mask(last_stage)
+            .src_access_mask(last_access)
+            .dst_stage_mask(vk::PipelineStageFlags2::BOTTOM_OF_PIPE)
+            .dst_access_mask(vk::AccessFlags2::NONE)
+            .old_layout(last_layout)
+            .new_layout(vk::ImageLayout::PRESENT_SRC_KHR)
+            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .image(dst)
+            .subresource_range(range)];
+        // SAFETY: `dst` is an acquired swapchain image; `src` is in TRANSFER_SRC_OPTIMAL (above).
+        unsafe {
+            let device = self.device();
+            device.cmd_pipeline_barrier2(self.cmd, &vk::DependencyInfo::default().image_memory_barriers(&to_transfer));
+            device.cmd_blit_image(
+                self.cmd,
+                src.raw,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                dst,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                &region,
+                vk::Filter::LINEAR,
+            );
+        }
+        if let Some((overlay, frame)) = overlay {
+            let attachment = [vk::RenderingAttachmentInfo::default()
+                .image_view(dst_view)
+                .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+                .load_op(vk::AttachmentLoadOp::LOAD)
+                .store_op(vk::AttachmentStoreOp::STORE)];
+            let area = vk::Rect2D { offset: vk::Offset2D::default(), extent: dst_extent };
+            let info = vk::RenderingInfo::default().render_area(area).layer_count(1).color_attachments(&attachment);
+            // SAFETY: the image is in COLOR_ATTACHMENT_OPTIMAL (barrier below, before the scope).
+            unsafe {
+                let device = self.device();
+                device
+                    .cmd_pipeline_barrier2(self.cmd, &vk::DependencyInfo::default().image_memory_barriers(&to_overlay));
+                device.cmd_begin_rendering(self.cmd, &info);
+            }
+            let drawn = overlay.record(self.cmd, dst_extent, frame);
+            unsafe { self.device().cmd_end_rendering(self.cmd) };
+            drawn?;
+        }
+        unsafe {
+            self.device()
+                .cmd_pipeline_barrier2(self.cmd, &vk::DependencyInfo::default().image_memory_barriers(&to_present));
+        }
         Ok(())
     }
 

@@ -81,7 +81,7 @@ impl DeviceInfo {
 
 /// Objects destroyed together, in reverse creation order, when the last owner drops.
 pub struct Shared {
-    pub(crate) _entry: ash::Entry,
+    pub(crate) entry: ash::Entry,
     pub(crate) instance: ash::Instance,
     debug: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
     pub(crate) device: ash::Device,
@@ -109,6 +109,7 @@ impl Drop for Shared {
 pub struct Context {
     pub(crate) shared: Arc<Shared>,
     pub(crate) physical_device: vk::PhysicalDevice,
+    pub(crate) queue_family: u32,
     pub(crate) queue: vk::Queue,
     pub properties: vk::PhysicalDeviceProperties,
     pub info: DeviceInfo,
@@ -183,6 +184,7 @@ fn create_instance(
     entry: &ash::Entry,
     validation: bool,
     counts: &Arc<ValidationCounts>,
+    window_extensions: &[*const std::ffi::c_char],
 ) -> Result<(ash::Instance, bool)> {
     // SAFETY: plain enumeration calls on a loaded entry.
     let layers = unsafe { entry.enumerate_instance_layer_properties() }
@@ -203,8 +205,9 @@ fn create_instance(
         .api_version(vk::API_VERSION_1_3);
 
     let layer_names: Vec<*const i8> = if validation { vec![VALIDATION_LAYER.as_ptr()] } else { vec![] };
-    let extension_names: Vec<*const i8> =
+    let mut extension_names: Vec<*const i8> =
         if messenger_wanted { vec![ash::ext::debug_utils::NAME.as_ptr()] } else { vec![] };
+    extension_names.extend_from_slice(window_extensions);
 
     let enabled_features = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
     let mut validation_features = vk::ValidationFeaturesEXT::default().enabled_validation_features(&enabled_features);
@@ -298,7 +301,7 @@ fn describe_devices(instance: &ash::Instance) -> Result<Vec<(vk::PhysicalDevice,
 pub fn list_devices() -> Result<Vec<DeviceInfo>> {
     let entry = load_entry()?;
     let counts = Arc::new(ValidationCounts::default());
-    let (instance, _) = create_instance(&entry, false, &counts)?;
+    let (instance, _) = create_instance(&entry, false, &counts, &[])?;
     let list = describe_devices(&instance);
     // SAFETY: nothing was created from this instance.
     unsafe { instance.destroy_instance(None) };
@@ -347,9 +350,24 @@ fn choose_device(
 
 impl Context {
     pub fn new(options: &ContextOptions) -> Result<Context> {
+        Self::create(options, None)
+    }
+
+    /// A context that can present to windows of `display`: the surface extensions for that window
+    /// system on the instance and VK_KHR_swapchain on the device (only `view` asks for them).
+    pub fn for_window(options: &ContextOptions, display: raw_window_handle::RawDisplayHandle) -> Result<Context> {
+        Self::create(options, Some(display))
+    }
+
+    fn create(options: &ContextOptions, display: Option<raw_window_handle::RawDisplayHandle>) -> Result<Context> {
         let entry = load_entry()?;
         let counts = Arc::new(ValidationCounts::default());
-        let (instance, messenger_wanted) = create_instance(&entry, options.validation, &counts)?;
+        let window_extensions = match display {
+            Some(d) => ash_window::enumerate_required_extensions(d)
+                .map_err(|e| runtime!("no Vulkan surface extensions for this window system: {e}"))?,
+            None => &[],
+        };
+        let (instance, messenger_wanted) = create_instance(&entry, options.validation, &counts, window_extensions)?;
         // From here on, any early return must destroy the instance: wrap it at once.
         let cleanup_instance = |e: Error| {
             // SAFETY: nothing else uses the instance on this error path.
@@ -388,13 +406,24 @@ impl Context {
                 return Err(cleanup_instance(e));
             }
         };
-        match Self::create_device(entry.clone(), instance.clone(), debug, pd, info, counts, options.validation) {
+        let swapchain = display.is_some();
+        match Self::create_device(
+            entry.clone(),
+            instance.clone(),
+            debug,
+            pd,
+            info,
+            counts,
+            options.validation,
+            swapchain,
+        ) {
             Ok(ctx) => Ok(ctx),
             // create_device has already destroyed the messenger and the instance on failure.
             Err(e) => Err(e),
         }
     }
 
+    #[allow(clippy::too_many_arguments)]
     fn create_device(
         entry: ash::Entry,
         instance: ash::Instance,
@@ -403,6 +432,7 @@ impl Context {
         info: DeviceInfo,
         counts: Arc<ValidationCounts>,
         validation: bool,
+        swapchain: bool,
     ) -> Result<Context> {
         let fail = |debug: &Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>, e: Error| {
             // SAFETY: error path: nothing else uses these handles.
@@ -467,8 +497,21 @@ impl Context {
         let priorities = [1.0f32];
         let queue_info =
             [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family).queue_priorities(&priorities)];
+        let device_extensions: Vec<*const std::ffi::c_char> =
+            if swapchain { vec![ash::khr::swapchain::NAME.as_ptr()] } else { vec![] };
+        if swapchain {
+            // SAFETY: valid physical device.
+            let available = unsafe { instance.enumerate_device_extension_properties(pd) }.unwrap_or_default();
+            if !available.iter().any(|e| e.extension_name_as_c_str().ok() == Some(ash::khr::swapchain::NAME)) {
+                return Err(fail(
+                    &debug,
+                    runtime!("device {} cannot present to a window (no VK_KHR_swapchain)", info.name),
+                ));
+            }
+        }
         let device_info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_info)
+            .enabled_extension_names(&device_extensions)
             .enabled_features(&features10)
             .push_next(&mut features12)
             .push_next(&mut features13);
@@ -504,7 +547,7 @@ impl Context {
         };
 
         let shared = Arc::new(Shared {
-            _entry: entry,
+            entry,
             instance,
             debug,
             device,
@@ -515,6 +558,7 @@ impl Context {
         Ok(Context {
             shared,
             physical_device: pd,
+            queue_family,
             queue,
             properties,
             info,

@@ -4,16 +4,20 @@
 
 mod commands;
 mod context;
+mod overlay;
 mod pipeline;
 mod profiler;
 mod resources;
+mod swapchain;
 
 pub use ash::vk::{BufferUsageFlags, CullModeFlags, Extent2D, Format, ImageUsageFlags, PrimitiveTopology};
 pub use commands::{Bind, Recorder};
 pub use context::{list_devices, Context, ContextOptions, DeviceInfo, ValidationCounts};
+pub use overlay::{Overlay, OverlayFrame};
 pub use pipeline::{check_all_shaders, BindingKind, GraphicsDesc, Pipeline};
 pub use profiler::{GpuProfiler, TimedScope};
 pub use resources::{Access, Buffer, Image, MemoryLocation, Sampler};
+pub use swapchain::{PresentMode, Presented, Presenter, FRAMES_IN_FLIGHT};
 
 /// Reinterprets a plain value as bytes for push constants.
 pub fn bytes_of<T: bytemuck::Pod>(value: &T) -> &[u8] {

@@ -1,0 +1,150 @@
+//! Meshes that change between frames: built-in deformations and `{frame}` sequences, through the
+//! one frame path (validation on).
+
+mod common;
+
+use common::{assert_clean, output_dir, stderr, translucent, validated_context};
+use glam::Vec3;
+use translucent::deform::{Animation, Deformation};
+use translucent::frame::{FrameOptions, Renderer, Show, SubsurfaceOptions};
+use translucent::hierarchy::HierarchyOptions;
+use translucent::materials::Material;
+use translucent::mesh::Mesh;
+use translucent::output::{self, Exposure};
+use translucent::physics::{Diffusion, Model};
+use translucent::scene::{Camera, Light, Scene};
+
+fn renderer_for(ctx: translucent::vk::Context, scene: &Scene, points: u32) -> Renderer {
+    let options = FrameOptions {
+        subsurface: SubsurfaceOptions {
+            material: Material::find("marble").unwrap(),
+            model: Model::Directional,
+            diffusion: Diffusion::Classical,
+            epsilon: 0.1,
+            brute_force: false,
+            specular: true,
+            roughness: 0.35,
+        },
+        width: 24,
+        height: 24,
+        profile: false,
+        count_work: false,
+        hierarchy: HierarchyOptions { point_count: points, shadow_resolution: 64, eta: 1.5 },
+        show: Show::Shading,
+        exposure: Exposure::Stops(0.0),
+    };
+    Renderer::new(ctx, scene, options).expect("renderer")
+}
+
+#[test]
+fn each_frame_samples_the_deformed_surface() {
+    let (ctx, counts) = validated_context();
+    let base = Mesh::slab(1.0, 1.0, 2.0);
+    let camera = Camera::framing(Vec3::ZERO, 2.0, 40.0, Vec3::new(0.3, 0.3, 1.0));
+    let lights = vec![Light::Directional { toward: Vec3::new(0.2, 1.0, 0.5), irradiance: Vec3::ONE }];
+    let mut scene = Scene { mesh: base.clone(), camera, lights, mm_per_unit: 10.0 };
+    let points = 2048;
+    let mut renderer = renderer_for(ctx, &scene, points);
+    for deformation in [Deformation::Squash(0.25), Deformation::Twist(120.0)] {
+        let animation = Animation::new("box", &base, Some(deformation), 4, Vec3::Y).unwrap().expect("animated");
+        let mut areas = Vec::new();
+        for frame in 0..4 {
+            scene.mesh = animation.mesh(frame).unwrap();
+            renderer.set_mesh(&scene.mesh).unwrap();
+            renderer.render_frame(&scene).unwrap();
+            let snapshot = renderer.hierarchy.download(&renderer.ctx).unwrap();
+            assert_eq!(snapshot.points.len(), points as usize);
+            // The points' areas add up to the deformed mesh's area, and the points lie within it.
+            let sampled: f64 = snapshot.points.iter().map(|p| p.area as f64).sum();
+            let area = scene.mesh.surface_area() as f64;
+            assert!((sampled / area - 1.0).abs() < 1e-3, "{deformation:?} frame {frame}: {sampled} vs {area}");
+            let (lo, hi) = scene.mesh.bounds();
+            for p in &snapshot.points {
+                assert!(p.position.cmpge(lo - 1e-4).all() && p.position.cmple(hi + 1e-4).all(), "{p:?}");
+            }
+            areas.push(area);
+        }
+        if let Deformation::Squash(_) = deformation {
+            // The 1×2×1 box squashed to a quarter of its height (widths × 2): area 10 → 12.
+            assert!((areas[2] / areas[0] - 1.0).abs() > 0.05, "{areas:?}");
+        }
+        assert!((areas[1] - areas[3]).abs() < 1e-4 * areas[1], "the period's two halves mirror: {areas:?}");
+    }
+    drop(renderer);
+    assert_clean(&counts);
+}
+
+/// Renders `args` with validation at 64x64 into `{name}-{frame}.png` files; returns their paths.
+fn render_frames(name: &str, args: &[&str], frames: u32) -> Vec<std::path::PathBuf> {
+    let out = output_dir().join(format!("{name}-{{frame}}.png"));
+    let frames_arg = frames.to_string();
+    let mut full = vec!["render", "--validation", "--width", "64", "--height", "64", "--samples", "4096"];
+    full.extend_from_slice(&["--exposure", "0", "--frames", &frames_arg, "--out", out.to_str().unwrap()]);
+    full.extend_from_slice(args);
+    let result = translucent(&full);
+    assert!(result.status.success(), "{name}: {}", stderr(&result));
+    assert!(!stderr(&result).contains("vulkan"), "{name}: validation messages:\n{}", stderr(&result));
+    (0..frames).map(|i| output_dir().join(format!("{name}-{i:04}.png"))).collect()
+}
+
+fn load(path: &std::path::Path) -> image::RgbaImage {
+    image::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display())).into_rgba8()
+}
+
+#[test]
+fn twisted_then_untwisted_renders_like_the_original() {
+    // Period 2: frame 0 is the box, frame 1 twisted 90°, frame 2 untwisted again.
+    let paths = render_frames("twist", &["--mesh", "box", "--deform", "twist:90", "--deform-period", "2"], 3);
+    let [original, twisted, untwisted] = [0, 1, 2].map(|i| load(&paths[i]));
+    let moved = output::compare(&original, &twisted).unwrap();
+    assert!(moved.differing_fraction > 0.05, "the twist must show: {moved:?}");
+    let back = output::compare(&original, &untwisted).unwrap();
+    assert!(back.rmse < 0.5 && back.differing_fraction < 0.002, "{back:?}");
+}
+
+#[test]
+fn a_frame_sequence_plays_one_file_per_frame() {
+    let dir = output_dir().join("sequence");
+    std::fs::create_dir_all(&dir).unwrap();
+    // A cube, then the same cube twice as tall.
+    let cube = |height: f32| {
+        let mut obj = String::new();
+        for &(x, y, z) in &[(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (0, 0, 1), (1, 0, 1), (1, 1, 1), (0, 1, 1)] {
+            obj += &format!("v {} {} {}\n", x as f32 - 0.5, y as f32 * height - 0.5, z as f32 - 0.5);
+        }
+        for f in ["1 4 3 2", "5 6 7 8", "1 2 6 5", "2 3 7 6", "3 4 8 7", "4 1 5 8"] {
+            obj += &format!("f {f}\n");
+        }
+        obj
+    };
+    std::fs::write(dir.join("cube-0.obj"), cube(1.0)).unwrap();
+    std::fs::write(dir.join("cube-1.obj"), cube(2.0)).unwrap();
+    let pattern = dir.join("cube-{frame}.obj");
+    // The camera and lights stay those framing frame 0 (--eye, so the framing is the same).
+    let common = ["--eye", "2,2,4", "--target", "0,0,0", "--light-dir", "0.3,1,0.5"];
+    let mut args = vec!["--mesh", pattern.to_str().unwrap()];
+    args.extend_from_slice(&common);
+    let played = render_frames("sequence", &args, 2);
+    for (i, path) in played.iter().enumerate() {
+        let file = dir.join(format!("cube-{i}.obj"));
+        let mut single = vec!["--mesh", file.to_str().unwrap()];
+        single.extend_from_slice(&common);
+        let alone = render_frames(&format!("sequence-alone-{i}"), &single, 1);
+        let diff = output::compare(&load(path), &load(&alone[0])).unwrap();
+        assert!(diff.rmse < 0.5, "frame {i} of the sequence differs from its file rendered alone: {diff:?}");
+    }
+    let change = output::compare(&load(&played[0]), &load(&played[1])).unwrap();
+    assert!(change.differing_fraction > 0.05, "the two frames must differ: {change:?}");
+}
+
+#[test]
+fn bad_deformations_are_bad_input() {
+    for (value, needle) in [("bend:3", "twist or squash"), ("squash:0", "positive"), ("twist:x", "not a number")] {
+        let out = translucent(&["render", "--mesh", "sphere", "--deform", value]);
+        assert_eq!(out.status.code(), Some(2), "{value}: {}", stderr(&out));
+        assert!(stderr(&out).contains(needle), "{value}: {}", stderr(&out));
+    }
+    let out = translucent(&["render", "--mesh", "/nonexistent/frame-{frame}.obj"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("frame-{frame}.obj"), "{}", stderr(&out));
+}
