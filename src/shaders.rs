@@ -23,8 +23,10 @@ pub fn member_offsets(shader: &str, type_name: &str) -> Option<Vec<u32>> {
     const OP_MEMBER_DECORATE: u32 = 72;
     const DECORATION_OFFSET: u32 = 35;
     let words = spirv(shader)?;
-    let mut type_id = None;
-    let mut offsets: Vec<(u32, u32)> = Vec::new();
+    // glslang may emit a struct twice under one name: laid out (with offsets) as a buffer's member
+    // type, and plain for a function-local copy. The laid-out one is the one that counts.
+    let mut type_ids = Vec::new();
+    let mut offsets: Vec<(u32, u32, u32)> = Vec::new();
     let mut i = 5; // skip the header
     while i < words.len() {
         let count = (words[i] >> 16) as usize;
@@ -36,16 +38,18 @@ pub fn member_offsets(shader: &str, type_name: &str) -> Option<Vec<u32>> {
         if opcode == OP_NAME && operands.len() >= 2 {
             let bytes: Vec<u8> = operands[1..].iter().flat_map(|w| w.to_le_bytes()).take_while(|b| *b != 0).collect();
             if bytes == type_name.as_bytes() {
-                type_id = Some(operands[0]);
+                type_ids.push(operands[0]);
             }
         }
         let is_offset = opcode == OP_MEMBER_DECORATE && operands.len() >= 4 && operands[2] == DECORATION_OFFSET;
-        if is_offset && Some(operands[0]) == type_id {
-            offsets.push((operands[1], operands[3]));
+        if is_offset && type_ids.contains(&operands[0]) {
+            offsets.push((operands[0], operands[1], operands[3]));
         }
         i += count;
     }
-    type_id?;
+    let laid_out = offsets.first().map(|o| o.0).or(type_ids.first().copied())?;
+    let mut offsets: Vec<(u32, u32)> =
+        offsets.into_iter().filter(|o| o.0 == laid_out).map(|(_, member, offset)| (member, offset)).collect();
     offsets.sort();
     Some(offsets.into_iter().map(|(_, offset)| offset).collect())
 }
