@@ -50,7 +50,12 @@ impl Camera {
         let radius = ((bounds.1 - bounds.0).length() * 0.5).max(1e-30);
         let distance = (centre - self.eye).length();
         let far = distance + radius * 1.5;
-        let near = (distance - radius * 1.5).max(far * 1e-4);
+        // In f32, far and near can round to the same value when the eye is far away relative to
+        // the mesh (eye 4e9 from a unit sphere): keep them apart so the matrix stays finite.
+        let mut near = (distance - radius * 1.5).max(far * 1e-4);
+        if near >= far {
+            near = far * 0.5;
+        }
         let mut projection = Mat4::perspective_rh(self.fov_y_deg.to_radians(), aspect, near, far);
         projection.y_axis.y = -projection.y_axis.y;
         projection * view

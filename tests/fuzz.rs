@@ -348,6 +348,22 @@ where
 
 const CI_CASES: u32 = 1500;
 
+/// Inputs the long fuzz runs found failing, kept as regression cases.
+#[test]
+fn fuzz_findings_stay_fixed() {
+    let header = bssrdf_csv::COLUMNS.join(",");
+    for row in [
+        "1,1,0,1.3,0,0,0,0,0,-1,0,0,-1,0,0,1.6460873221073073e154,0,0,1", // position 1.6e154 mm
+        "0,0.76,0.1,1e-104,0,0,0,0,0,-1,0,0,1,0,0,0,0,0,-1",              // η = 1e-104
+        "1e154,1.65,0,0.44,0,0,0,0,0,-1,0,0,-1,0,0,0,0,0,-1",             // σa = 1e154
+        "-0.0,1e-154,0,1.05,0,0,0,0,0,1,0,0,1,0,0,0,0,0,-1",              // σs = 1e-154
+    ] {
+        check_csv(format!("{header}\n{row}\n").as_bytes()).unwrap();
+    }
+    let argv: Vec<String> = ["translucent", "render", "--eye", "0,-3.5e0,4294967296"].map(String::from).to_vec();
+    check_argv(&argv).unwrap();
+}
+
 #[test]
 fn obj_reader_properties() {
     run_cases(&obj_text(), CI_CASES, 1, |b| check_obj(&b));
