@@ -336,7 +336,15 @@ where
     let mut total = 0u64;
     let mut round = 0u64;
     while start.elapsed().as_secs() < seconds {
-        run_cases(&strategy, 256, base.wrapping_add(round), check);
+        let seed = base.wrapping_add(round);
+        let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run_cases(&strategy, 256, seed, check)));
+        if let Err(panic) = outcome {
+            println!(
+                "fuzz {name}: FAILED after about {total} inputs in {:.0} s (seed {seed})",
+                start.elapsed().as_secs_f64()
+            );
+            std::panic::resume_unwind(panic);
+        }
         total += 256;
         round += 1;
     }
