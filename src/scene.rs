@@ -37,8 +37,9 @@ impl Camera {
         if forward.cross(self.up).length() < 1e-6 * forward.length() * self.up.length().max(1e-30) {
             return Err(bad_input!("camera: --up is zero or parallel to the view direction"));
         }
-        if !(self.fov_y_deg > 0.0 && self.fov_y_deg < 180.0) {
-            return Err(bad_input!("--fov {}: must be between 0 and 180 degrees (exclusive)", self.fov_y_deg));
+        // Below a thousandth of a degree 1/tan(fov/2) leaves f32 (1e-37 gave an infinite matrix).
+        if !(self.fov_y_deg >= 1e-3 && self.fov_y_deg < 180.0) {
+            return Err(bad_input!("--fov {}: must be at least 0.001 and below 180 degrees", self.fov_y_deg));
         }
         Ok(())
     }

@@ -368,8 +368,10 @@ fn fuzz_findings_stay_fixed() {
     ] {
         check_csv(format!("{header}\n{row}\n").as_bytes()).unwrap();
     }
-    let argv: Vec<String> = ["translucent", "render", "--eye", "0,-3.5e0,4294967296"].map(String::from).to_vec();
-    check_argv(&argv).unwrap();
+    for args in [["--eye", "0,-3.5e0,4294967296"], ["--fov", "1e-37"]] {
+        let argv: Vec<String> = ["translucent", "render"].iter().chain(&args).map(|s| s.to_string()).collect();
+        check_argv(&argv).unwrap();
+    }
 }
 
 #[test]
