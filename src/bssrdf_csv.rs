@@ -173,8 +173,9 @@ fn to_query(v: &[f64; 19]) -> std::result::Result<Query, String> {
         if v[i] < 0.0 {
             return Err(format!("column {name}: {} is negative", v[i]));
         }
-        if v[i] > crate::materials::MAX_SIGMA {
-            return Err(format!("column {name}: {:e} is above {:e} /mm", v[i], crate::materials::MAX_SIGMA));
+        let (lo, hi) = (crate::materials::MIN_SIGMA, crate::materials::MAX_SIGMA);
+        if v[i] > hi || (v[i] > 0.0 && v[i] < lo) {
+            return Err(format!("column {name}: {:e} must be 0 or within [{lo:e}, {hi:e}] /mm", v[i]));
         }
     }
     if v[2] <= -1.0 || v[2] >= 1.0 {

@@ -86,6 +86,9 @@ fn key(name: &str) -> String {
 /// The largest σa or σs accepted (1/mm): far past any measured material (those are below 1e4),
 /// and where σt² stays finite in f64.
 pub const MAX_SIGMA: f64 = 1e100;
+/// The smallest non-zero σa or σs accepted (1/mm): below it the diffusion lengths' squares
+/// overflow f64 (σ = 1e-154 gave NaN).
+pub const MIN_SIGMA: f64 = 1e-100;
 
 pub const ETA_RANGE: (f64, f64) = (0.1, 10.0);
 
@@ -126,24 +129,31 @@ impl Material {
 
     /// Rejects values the models cannot take, naming the offending one.
     pub fn validate(&self) -> Result<()> {
-        for (what, values) in [("sigma_a", self.sigma_a), ("sigma_s", self.sigma_s)] {
+        // Each message names the value and the flag that sets it.
+        for (what, flag, values) in [("sigma_a", "--sigma-a", self.sigma_a), ("sigma_s", "--sigma-s", self.sigma_s)] {
             for (ch, v) in values.iter().enumerate() {
                 if !v.is_finite() || *v < 0.0 {
-                    return Err(bad_input!("{}: {what} = {v} in channel {ch} must be finite and ≥ 0", self.name));
+                    return Err(bad_input!(
+                        "{}: {what} = {v} in channel {ch} must be finite and ≥ 0 ({flag})",
+                        self.name
+                    ));
                 }
-                if *v > MAX_SIGMA {
-                    return Err(bad_input!("{}: {what} = {v:e} in channel {ch} is above {MAX_SIGMA:e} /mm", self.name));
+                if *v > MAX_SIGMA || (*v > 0.0 && *v < MIN_SIGMA) {
+                    return Err(bad_input!(
+                        "{}: {what} = {v:e} in channel {ch} must be 0 or within [{MIN_SIGMA:e}, {MAX_SIGMA:e}] /mm ({flag})",
+                        self.name
+                    ));
                 }
             }
         }
         for (ch, g) in self.g.iter().enumerate() {
             if !g.is_finite() || g.abs() >= 1.0 {
-                return Err(bad_input!("{}: g = {g} in channel {ch} must lie in (−1, 1)", self.name));
+                return Err(bad_input!("{}: g = {g} in channel {ch} must lie in (−1, 1) (--g)", self.name));
             }
         }
         if !(ETA_RANGE.0..=ETA_RANGE.1).contains(&self.eta) {
             return Err(bad_input!(
-                "{}: eta = {} must be finite and within [{}, {}]",
+                "{}: eta = {} must be finite and within [{}, {}] (--eta)",
                 self.name,
                 self.eta,
                 ETA_RANGE.0,

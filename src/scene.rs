@@ -37,8 +37,9 @@ impl Camera {
         if forward.cross(self.up).length() < 1e-6 * forward.length() * self.up.length().max(1e-30) {
             return Err(bad_input!("camera: --up is zero or parallel to the view direction"));
         }
-        if !(self.fov_y_deg > 0.0 && self.fov_y_deg < 180.0) {
-            return Err(bad_input!("--fov {}: must be between 0 and 180 degrees (exclusive)", self.fov_y_deg));
+        // Below a thousandth of a degree 1/tan(fov/2) leaves f32 (1e-37 gave an infinite matrix).
+        if !(self.fov_y_deg >= 1e-3 && self.fov_y_deg < 180.0) {
+            return Err(bad_input!("--fov {}: must be at least 0.001 and below 180 degrees", self.fov_y_deg));
         }
         Ok(())
     }
@@ -50,7 +51,12 @@ impl Camera {
         let radius = ((bounds.1 - bounds.0).length() * 0.5).max(1e-30);
         let distance = (centre - self.eye).length();
         let far = distance + radius * 1.5;
-        let near = (distance - radius * 1.5).max(far * 1e-4);
+        // In f32, far and near can round to the same value when the eye is far away relative to
+        // the mesh (eye 4e9 from a unit sphere): keep them apart so the matrix stays finite.
+        let mut near = (distance - radius * 1.5).max(far * 1e-4);
+        if near >= far {
+            near = far * 0.5;
+        }
         let mut projection = Mat4::perspective_rh(self.fov_y_deg.to_radians(), aspect, near, far);
         projection.y_axis.y = -projection.y_axis.y;
         projection * view

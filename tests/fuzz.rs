@@ -336,7 +336,15 @@ where
     let mut total = 0u64;
     let mut round = 0u64;
     while start.elapsed().as_secs() < seconds {
-        run_cases(&strategy, 256, base.wrapping_add(round), check);
+        let seed = base.wrapping_add(round);
+        let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run_cases(&strategy, 256, seed, check)));
+        if let Err(panic) = outcome {
+            println!(
+                "fuzz {name}: FAILED after about {total} inputs in {:.0} s (seed {seed})",
+                start.elapsed().as_secs_f64()
+            );
+            std::panic::resume_unwind(panic);
+        }
         total += 256;
         round += 1;
     }
@@ -347,6 +355,24 @@ where
 }
 
 const CI_CASES: u32 = 1500;
+
+/// Inputs the long fuzz runs found failing, kept as regression cases.
+#[test]
+fn fuzz_findings_stay_fixed() {
+    let header = bssrdf_csv::COLUMNS.join(",");
+    for row in [
+        "1,1,0,1.3,0,0,0,0,0,-1,0,0,-1,0,0,1.6460873221073073e154,0,0,1", // position 1.6e154 mm
+        "0,0.76,0.1,1e-104,0,0,0,0,0,-1,0,0,1,0,0,0,0,0,-1",              // η = 1e-104
+        "1e154,1.65,0,0.44,0,0,0,0,0,-1,0,0,-1,0,0,0,0,0,-1",             // σa = 1e154
+        "-0.0,1e-154,0,1.05,0,0,0,0,0,1,0,0,1,0,0,0,0,0,-1",              // σs = 1e-154
+    ] {
+        check_csv(format!("{header}\n{row}\n").as_bytes()).unwrap();
+    }
+    for args in [["--eye", "0,-3.5e0,4294967296"], ["--fov", "1e-37"]] {
+        let argv: Vec<String> = ["translucent", "render"].iter().chain(&args).map(|s| s.to_string()).collect();
+        check_argv(&argv).unwrap();
+    }
+}
 
 #[test]
 fn obj_reader_properties() {
