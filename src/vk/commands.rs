@@ -30,26 +30,41 @@ const SETS_PER_SUBMIT: u32 = 512;
 /// timestamp, as ALL_COMMANDS does, without the best-practices layer's warning about the latter.
 const TIMESTAMP_STAGE: vk::PipelineStageFlags2 = vk::PipelineStageFlags2::BOTTOM_OF_PIPE;
 
+/// A transient command pool and one primary command buffer from it, for `queue_family`.
+///
+/// # Safety
+/// `device` must be valid; the caller destroys the pool (which frees the buffer).
+pub(crate) unsafe fn command_pool_with_one_buffer(
+    device: &ash::Device,
+    queue_family: u32,
+) -> Result<(vk::CommandPool, vk::CommandBuffer)> {
+    let pool = device
+        .create_command_pool(
+            &vk::CommandPoolCreateInfo::default()
+                .queue_family_index(queue_family)
+                .flags(vk::CommandPoolCreateFlags::TRANSIENT),
+            None,
+        )
+        .map_err(|e| runtime!("vkCreateCommandPool: {e}"))?;
+    let cmd = device
+        .allocate_command_buffers(
+            &vk::CommandBufferAllocateInfo::default()
+                .command_pool(pool)
+                .level(vk::CommandBufferLevel::PRIMARY)
+                .command_buffer_count(1),
+        )
+        .map_err(|e| {
+            device.destroy_command_pool(pool, None);
+            runtime!("vkAllocateCommandBuffers: {e}")
+        })?[0];
+    Ok((pool, cmd))
+}
+
 impl Commands {
     pub(crate) fn new(device: &ash::Device, queue_family: u32) -> Result<Commands> {
         // SAFETY: valid device; each object is destroyed in `destroy`.
         unsafe {
-            let pool = device
-                .create_command_pool(
-                    &vk::CommandPoolCreateInfo::default()
-                        .queue_family_index(queue_family)
-                        .flags(vk::CommandPoolCreateFlags::TRANSIENT),
-                    None,
-                )
-                .map_err(|e| runtime!("vkCreateCommandPool: {e}"))?;
-            let cmd = device
-                .allocate_command_buffers(
-                    &vk::CommandBufferAllocateInfo::default()
-                        .command_pool(pool)
-                        .level(vk::CommandBufferLevel::PRIMARY)
-                        .command_buffer_count(1),
-                )
-                .map_err(|e| runtime!("vkAllocateCommandBuffers: {e}"))?[0];
+            let (pool, cmd) = command_pool_with_one_buffer(device, queue_family)?;
             let fence = device
                 .create_fence(&vk::FenceCreateInfo::default(), None)
                 .map_err(|e| runtime!("vkCreateFence: {e}"))?;

@@ -174,22 +174,7 @@ impl Presenter {
         let device = &self.shared.device;
         // SAFETY: valid device; the objects are destroyed in Drop.
         unsafe {
-            let pool = device
-                .create_command_pool(
-                    &vk::CommandPoolCreateInfo::default()
-                        .queue_family_index(queue_family)
-                        .flags(vk::CommandPoolCreateFlags::TRANSIENT),
-                    None,
-                )
-                .map_err(|e| runtime!("vkCreateCommandPool: {e}"))?;
-            let cmd = device
-                .allocate_command_buffers(
-                    &vk::CommandBufferAllocateInfo::default()
-                        .command_pool(pool)
-                        .level(vk::CommandBufferLevel::PRIMARY)
-                        .command_buffer_count(1),
-                )
-                .map_err(|e| runtime!("vkAllocateCommandBuffers: {e}"))?[0];
+            let (pool, cmd) = super::commands::command_pool_with_one_buffer(device, queue_family)?;
             // Signalled, so that the first wait on an unused slot returns at once.
             let fence = device
                 .create_fence(&vk::FenceCreateInfo::default().flags(vk::FenceCreateFlags::SIGNALED), None)
