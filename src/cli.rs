@@ -866,7 +866,7 @@ pub fn usage_exit(e: clap::Error) -> i32 {
         },
         ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand | ErrorKind::MissingSubcommand => {
             crate::note!(
-                "error: a command is required: render, devices, materials, bssrdf, profile or bench\n\n{}",
+                "error: a command is required: render, view, devices, materials, bssrdf, profile or bench\n\n{}",
                 e.render()
             );
             2
