@@ -182,17 +182,23 @@ fn irregular_grid(cells: u32) -> Mesh {
     Mesh { positions, normals, indices }
 }
 
-#[test]
-fn samples_are_uniform_by_area() {
-    let mesh = irregular_grid(20);
-    let n = 24_000u32;
-    let s = build(&mesh, &[sun(Vec3::Y, 1.0)], n);
+/// Each triangle's area, the total area (f64) and how many points fell on each triangle.
+fn points_per_triangle(mesh: &Mesh, s: &Snapshot) -> (Vec<f32>, f64, Vec<u32>) {
     let areas = mesh.triangle_areas();
     let total: f64 = areas.iter().map(|&a| a as f64).sum();
     let mut counts = vec![0u32; areas.len()];
     for p in &s.points {
         counts[p.triangle as usize] += 1;
     }
+    (areas, total, counts)
+}
+
+#[test]
+fn samples_are_uniform_by_area() {
+    let mesh = irregular_grid(20);
+    let n = 24_000u32;
+    let s = build(&mesh, &[sun(Vec3::Y, 1.0)], n);
+    let (areas, total, counts) = points_per_triangle(&mesh, &s);
     let chi2: f64 = counts
         .iter()
         .zip(&areas)
@@ -344,12 +350,7 @@ fn stratification_holds_over_two_million_triangles() {
     let mesh = irregular_grid(1000);
     let n = 1_000_003u32;
     let s = build(&mesh, &[sun(Vec3::Y, 1.0)], n);
-    let areas = mesh.triangle_areas();
-    let total: f64 = areas.iter().map(|&a| a as f64).sum();
-    let mut counts = vec![0u32; areas.len()];
-    for p in &s.points {
-        counts[p.triangle as usize] += 1;
-    }
+    let (areas, total, counts) = points_per_triangle(&mesh, &s);
     let group = 2000;
     let mut worst = 0.0f64;
     let (mut cumulative_area, mut cumulative_count) = (0.0f64, 0u64);
