@@ -1,8 +1,9 @@
 #version 460
-// Subsurface scattering per pixel: walks the Jensen–Buhler tree from the root with an explicit
-// stack; a node far and small enough (area / distance² from its area centre < epsilon, and xo
-// outside its box) is used whole: one source per light at that light's power centre; otherwise
-// its children are visited; points are evaluated singly, one source per light.
+// Subsurface scattering per pixel, in a full-screen pass over the G-buffer of the surface pass:
+// walks the Jensen–Buhler tree from the root with an explicit stack; a node far and small enough
+// (area / distance² from its area centre < epsilon, and xo outside its box) is used whole: two
+// sigma points per light; otherwise its children are visited; points are evaluated singly, one
+// source per light.
 // Lo(xo, wo) = Ft(eta, wo) · Σ over sources and lights Sd(xi, wi_k; xo, no) · power_k, power = E·A
 // (mm²), plus the surface's own reflection from each light: a microfacet lobe, shadowed by the
 // same shadow maps. Which nodes are used whole does not depend on the lights, and each term
@@ -14,16 +15,15 @@
 #include "lights.glsl"
 #include "microfacet.glsl"
 
-// Depth test before shading: the shader writes the work counters, and without this a driver may
-// run it for every layer of the mesh and test depth after (llvmpipe did: a 64x64 sphere counted
-// 6144 shaded pixels, its back faces walked the tree too).
-layout(early_fragment_tests) in;
+// The model, fixed per pipeline: llvmpipe runs both sides of a branch for every SIMD group, so a
+// model chosen at run time would cost both models' arithmetic (measured: the classical dipole
+// took 2.4x longer beside the directional one's dead code).
+layout(constant_id = 0) const uint MODEL = 0u; // 0 directional dipole, 1 classical dipole
 
-layout(location = 0) in vec3 world_position;
-layout(location = 1) in vec3 world_normal;
 layout(location = 0) out vec4 radiance;
 
-layout(std430, binding = 0) readonly buffer Params { SubsurfaceParams params; };
+// A uniform buffer: llvmpipe loads its members once per SIMD group (storage buffers per lane).
+layout(std140, binding = 0) uniform Params { SubsurfaceParams params; };
 layout(std430, binding = 1) readonly buffer Nodes { TreeNode nodes[]; };
 layout(std430, binding = 2) readonly buffer Sorted { SurfacePoint points[]; };
 // Work per pixel for --profile: sums and maxima of nodes visited and points evaluated.
@@ -33,6 +33,9 @@ layout(std430, binding = 4) readonly buffer Lights { LightSet light_set; mat4 la
 layout(binding = 5) uniform sampler2DArrayShadow shadow_map;
 layout(std430, binding = 6) readonly buffer SortedPointLights { PointLight point_lights[]; };
 layout(std430, binding = 7) readonly buffer NodeLights { NodeLight node_lights[]; };
+// The surface pass's G-buffer: world position (w = 1 where covered) and interpolated normal.
+layout(binding = 8, rgba32f) uniform readonly image2D surface_position;
+layout(binding = 9, rgba32f) uniform readonly image2D surface_normal;
 
 const uint STACK_SIZE = 96u;
 // Stack entries: a point or node index (below 2^24, with LEAF_BIT for points) and the number of
@@ -47,7 +50,7 @@ vec3 source(vec3 xi, vec3 ni, vec3 wi, vec3 power, vec3 xo, vec3 no) {
     float s = params.mm_per_unit;
     vec3 sd;
     // Written out, not looped: loop iterations count against llvmpipe's budget (see main).
-    if (params.model == 0u) {
+    if (MODEL == 0u) {
         // The geometry once for all three channels (they share eta).
         vec3 xi_mm = xi * s, xo_mm = xo * s;
         DirpoleGeometry g = dirpole_geometry(xi_mm, ni, wi, xo_mm, no, params.channels[0].eta);
@@ -87,8 +90,15 @@ vec3 specular(vec3 xo, vec3 no, vec3 wo) {
 }
 
 void main() {
-    vec3 xo = world_position;
-    vec3 no = normalize(world_normal);
+    ivec2 pixel = ivec2(gl_FragCoord.xy);
+    vec4 surface = imageLoad(surface_position, pixel);
+    if (surface.w == 0.0) {
+        // No surface: the background stays clear (and adds nothing to brute-force sums).
+        radiance = vec4(0.0);
+        return;
+    }
+    vec3 xo = surface.xyz;
+    vec3 no = normalize(imageLoad(surface_normal, pixel).xyz);
     vec3 wo = normalize(pc.eye.xyz - xo);
     vec3 sum = vec3(0.0);
     uint visits = 0u;

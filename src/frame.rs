@@ -68,6 +68,8 @@ macro_rules! shade_inputs {
         ShadeInputs {
             color: &$r.color,
             depth: &$r.depth,
+            position: &$r.position,
+            normal: &$r.normal,
             vertices: &$r.vertices,
             indices: &$r.indices,
             index_count: $r.index_count,
@@ -171,6 +173,8 @@ pub struct Renderer {
     /// Nodes and points per pixel, counted on the GPU when profiling.
     work_counters: Buffer,
     brute_force: bool,
+    /// The model's GPU code (`SubsurfaceParams::model`): which shading pipeline draws.
+    model: u32,
     shade: ShadePass,
     /// The lights the hierarchy was last given (re-sent only when they change).
     lights: Vec<crate::scene::Light>,
@@ -196,6 +200,9 @@ pub struct Renderer {
     bounds: (Vec3, Vec3),
     color: Image,
     depth: Image,
+    /// The G-buffer of the surface pass: world position and normal per pixel.
+    position: Image,
+    normal: Image,
     tonemap: TonemapPass,
     exposure: Exposure,
     histogram: Buffer,
@@ -247,7 +254,7 @@ impl Renderer {
             &scene.mesh.indices,
             BufferUsageFlags::INDEX_BUFFER | BufferUsageFlags::STORAGE_BUFFER,
         )?;
-        let Targets { color, depth, readback, ldr } = Targets::new(&ctx, extent)?;
+        let Targets { color, depth, position, normal, readback, ldr } = Targets::new(&ctx, extent)?;
         let histogram = Buffer::new(
             &ctx,
             "luminance histogram",
@@ -270,7 +277,7 @@ impl Renderer {
             &ctx,
             "subsurface parameters",
             std::mem::size_of::<SubsurfaceParams>() as u64,
-            BufferUsageFlags::STORAGE_BUFFER,
+            BufferUsageFlags::STORAGE_BUFFER | BufferUsageFlags::UNIFORM_BUFFER,
             MemoryLocation::CpuToGpu,
         )?;
         subsurface_params.write(0, &[params])?;
@@ -280,6 +287,7 @@ impl Renderer {
             subsurface_params,
             work_counters,
             brute_force: subsurface.brute_force,
+            model: params.model,
             shade,
             lights: scene.lights.clone(),
             tile: DEFAULT_TILE,
@@ -297,6 +305,8 @@ impl Renderer {
             bounds: scene.mesh.bounds(),
             color,
             depth,
+            position,
+            normal,
             tonemap: TonemapPass::new(&ctx)?,
             exposure,
             histogram,
@@ -320,8 +330,9 @@ impl Renderer {
         }
         // A window's copy of the last image may still be reading these targets.
         self.ctx.wait_idle()?;
-        let Targets { color, depth, readback, ldr } = Targets::new(&self.ctx, extent)?;
-        (self.color, self.depth, self.readback, self.ldr, self.extent) = (color, depth, readback, ldr, extent);
+        let Targets { color, depth, position, normal, readback, ldr } = Targets::new(&self.ctx, extent)?;
+        (self.color, self.depth, self.position, self.normal) = (color, depth, position, normal);
+        (self.readback, self.ldr, self.extent) = (readback, ldr, extent);
         // Learn again whether a frame of this size fits one submission.
         if !self.tile_fixed {
             self.whole_frame = false;
@@ -355,6 +366,7 @@ impl Renderer {
         params.count_work = count_work;
         self.subsurface_params.write(0, &[params])?;
         self.brute_force = subsurface.brute_force;
+        self.model = params.model;
         self.hierarchy.set_eta(subsurface.material.eta as f32)
     }
 
@@ -481,18 +493,21 @@ impl Renderer {
             }
             self.lights = scene.lights.clone();
         }
+        if self.show == Show::Shading {
+            self.shade.prepare(&self.ctx, self.model, self.brute_force)?;
+        }
         let inputs = shade_inputs!(self);
 
         // The frame, in order: the hierarchy (sampling, shadow maps, irradiance, Morton codes,
-        // sort, tree build, summaries; each its own scope), the depth pre-pass, shading in
-        // tiles, debug views, then read-back.
+        // sort, tree build, summaries; each its own scope), the surface pass (G-buffer), shading
+        // in tiles, debug views, then read-back.
         if let Some(p) = self.profiler.as_mut() {
             p.begin_frame();
         }
         self.ctx.submit(self.profiler.as_mut(), |rec| {
             self.hierarchy.record(rec, &self.vertices, &self.indices)?;
-            rec.begin_scope("depth pre-pass");
-            self.shade.record_depth(rec, &inputs, &view_projection)?;
+            rec.begin_scope("surface");
+            self.shade.record_surface(rec, &inputs, &constants)?;
             rec.end_scope();
             Ok(())
         })?;
@@ -538,7 +553,7 @@ impl Renderer {
             self.ctx.submit(self.profiler.as_mut(), |rec| {
                 rec.begin_scope("shade");
                 for unit in batch {
-                    self.shade.record_unit(rec, &inputs, &constants, unit)?;
+                    self.shade.record_unit(rec, &inputs, &constants, unit, self.model)?;
                 }
                 rec.end_scope();
                 Ok(())
@@ -673,6 +688,8 @@ impl Renderer {
 struct Targets {
     color: Image,
     depth: Image,
+    position: Image,
+    normal: Image,
     readback: Buffer,
     ldr: Buffer,
 }
@@ -689,6 +706,11 @@ impl Targets {
         )?;
         let depth =
             Image::new_2d(ctx, "depth", shade::DEPTH_FORMAT, extent, 1, ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT)?;
+        let surface = |name| {
+            let usage = ImageUsageFlags::COLOR_ATTACHMENT | ImageUsageFlags::STORAGE;
+            Image::new_2d(ctx, name, shade::SURFACE_FORMAT, extent, 1, usage)
+        };
+        let (position, normal) = (surface("surface position")?, surface("surface normal")?);
         let readback_bytes = extent.width as u64 * extent.height as u64 * 16;
         let readback =
             Buffer::new(ctx, "readback", readback_bytes, BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)?;
@@ -700,7 +722,7 @@ impl Targets {
             BufferUsageFlags::STORAGE_BUFFER | BufferUsageFlags::TRANSFER_SRC,
             MemoryLocation::GpuToCpu,
         )?;
-        Ok(Targets { color, depth, readback, ldr })
+        Ok(Targets { color, depth, position, normal, readback, ldr })
     }
 }
 

@@ -47,6 +47,7 @@ impl DebugViewPass {
                 depth_bias: false,
                 cull_mode: CullModeFlags::NONE,
                 additive_blend: false,
+                specialization: &[],
                 bindings,
                 push_constant_size: std::mem::size_of::<DebugConstants>() as u32,
             }

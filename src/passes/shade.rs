@@ -1,7 +1,10 @@
-//! The shade pass: rasterises the mesh and, per fragment, integrates the BSSRDF over the tree
-//! (shaders/shade.frag), plus the surface's microfacet reflection. Reads: vertices, indices,
-//! parameters, tree nodes, sorted points, their light records, lights and shadow maps. Writes: colour and depth
-//! targets, work counters.
+//! The surface and shade passes. The surface pass rasterises the mesh once into a G-buffer
+//! (depth, world position, normal: shaders/surface.frag); the shade pass is a full-screen
+//! triangle per tile that, per pixel, integrates the BSSRDF over the tree (shaders/shade.frag),
+//! plus the surface's microfacet reflection. Surface reads: vertices, indices; writes: depth,
+//! position, normal, and clears colour and work counters. Shade reads: parameters, tree nodes,
+//! sorted points, their light records, lights, shadow maps, position and normal; writes: colour,
+//! work counters.
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec4};
@@ -13,9 +16,10 @@ use crate::vk::{
 };
 
 pub const COLOR_FORMAT: Format = Format::R32G32B32A32_SFLOAT;
-/// Depth, and stencil to shade each pixel once even where triangles coincide (every copy of a
-/// repeated triangle passes the EQUAL depth test): see `GraphicsDesc::depth_equal`.
 pub const DEPTH_FORMAT: Format = Format::D32_SFLOAT_S8_UINT;
+/// The G-buffer: world position (w = 1 where covered) and interpolated normal, f32 so that shading
+/// sees the values a fragment shader on the mesh would have.
+pub const SURFACE_FORMAT: Format = Format::R32G32B32A32_SFLOAT;
 
 /// Mirrors `ShadeConstants` in shaders/include/shade_constants.glsl (std430 push constants).
 #[repr(C)]
@@ -67,6 +71,8 @@ pub struct WorkCounters {
 pub struct ShadeInputs<'a> {
     pub color: &'a Image,
     pub depth: &'a Image,
+    pub position: &'a Image,
+    pub normal: &'a Image,
     pub vertices: &'a Buffer,
     pub indices: &'a Buffer,
     pub index_count: u32,
@@ -112,97 +118,115 @@ pub fn shade_units(width: u32, height: u32, tile: u32, brute_force_points: Optio
 }
 
 pub struct ShadePass {
-    /// Depth only, so that the expensive fragment shader runs once per pixel (EQUAL test).
-    depth_prepass: Pipeline,
-    pipeline: Pipeline,
-    /// The same shader with additive blending, for brute force in several draws.
-    additive: Pipeline,
+    /// The mesh to the G-buffer (depth, position, normal).
+    surface: Pipeline,
+    /// Shading per model (`Model::gpu_code`), made on first use: [model][additive], the additive
+    /// one for brute force in several draws.
+    shading: [[Option<Pipeline>; 2]; 2],
 }
 
 /// Bytes per vertex: position and normal, 3 floats each.
 const VERTEX_STRIDE: u32 = 24;
 
+fn shading_pipeline(ctx: &Context, model: u32, additive_blend: bool) -> Result<Pipeline> {
+    use BindingKind::*;
+    Pipeline::graphics(
+        ctx,
+        &GraphicsDesc {
+            vertex_shader: "fullscreen.vert",
+            fragment_shader: Some("shade.frag"),
+            vertex_stride: 0,
+            vertex_attributes: &[],
+            topology: PrimitiveTopology::TRIANGLE_LIST,
+            color_formats: &[COLOR_FORMAT],
+            depth_format: None,
+            depth_test: false,
+            depth_equal: false,
+            depth_bias: false,
+            cull_mode: CullModeFlags::NONE,
+            additive_blend,
+            specialization: &[model],
+            bindings: &[
+                UniformBuffer,
+                StorageBuffer,
+                StorageBuffer,
+                StorageBuffer,
+                StorageBuffer,
+                SampledImage,
+                StorageBuffer,
+                StorageBuffer,
+                StorageImage,
+                StorageImage,
+            ],
+            push_constant_size: std::mem::size_of::<ShadeConstants>() as u32,
+        },
+    )
+}
+
 impl ShadePass {
     pub fn new(ctx: &Context) -> Result<ShadePass> {
-        use BindingKind::*;
-        let shading = |additive_blend: bool| {
-            Pipeline::graphics(
-                ctx,
-                &GraphicsDesc {
-                    vertex_shader: "shade.vert",
-                    fragment_shader: Some("shade.frag"),
-                    vertex_stride: VERTEX_STRIDE,
-                    vertex_attributes: &[(0, Format::R32G32B32_SFLOAT, 0), (1, Format::R32G32B32_SFLOAT, 12)],
-                    topology: PrimitiveTopology::TRIANGLE_LIST,
-                    color_formats: &[COLOR_FORMAT],
-                    depth_format: Some(DEPTH_FORMAT),
-                    depth_test: true,
-                    depth_equal: true,
-                    depth_bias: false,
-                    cull_mode: CullModeFlags::NONE,
-                    additive_blend,
-                    bindings: &[
-                        StorageBuffer,
-                        StorageBuffer,
-                        StorageBuffer,
-                        StorageBuffer,
-                        StorageBuffer,
-                        SampledImage,
-                        StorageBuffer,
-                        StorageBuffer,
-                    ],
-                    push_constant_size: std::mem::size_of::<ShadeConstants>() as u32,
-                },
-            )
-        };
-        let pipeline = shading(false)?;
-        let additive = shading(true)?;
-        let depth_prepass = Pipeline::graphics(
+        let surface = Pipeline::graphics(
             ctx,
             &GraphicsDesc {
-                vertex_shader: "hierarchy/shadow.vert",
-                fragment_shader: None,
+                vertex_shader: "surface.vert",
+                fragment_shader: Some("surface.frag"),
                 vertex_stride: VERTEX_STRIDE,
-                vertex_attributes: &[(0, Format::R32G32B32_SFLOAT, 0)],
+                vertex_attributes: &[(0, Format::R32G32B32_SFLOAT, 0), (1, Format::R32G32B32_SFLOAT, 12)],
                 topology: PrimitiveTopology::TRIANGLE_LIST,
-                color_formats: &[],
+                color_formats: &[SURFACE_FORMAT, SURFACE_FORMAT],
                 depth_format: Some(DEPTH_FORMAT),
                 depth_test: true,
                 depth_equal: false,
                 depth_bias: false,
                 cull_mode: CullModeFlags::NONE,
                 additive_blend: false,
+                specialization: &[],
                 bindings: &[],
-                push_constant_size: 64,
+                push_constant_size: std::mem::size_of::<ShadeConstants>() as u32,
             },
         )?;
-        Ok(ShadePass { depth_prepass, pipeline, additive })
+        Ok(ShadePass { surface, shading: Default::default() })
     }
 
-    /// Clears the colour target and the work counters and lays down depth, so that the shading
-    /// draws run their fragment shader once per pixel.
-    pub fn record_depth(&self, rec: &mut Recorder, inputs: &ShadeInputs, view_projection: &Mat4) -> Result<()> {
+    /// Makes the shading pipeline of `model` (and its additive twin for brute force) if not made
+    /// yet: each is a compilation on llvmpipe, so only what a frame uses is made.
+    pub fn prepare(&mut self, ctx: &Context, model: u32, brute_force: bool) -> Result<()> {
+        let slots = &mut self.shading[model as usize];
+        if slots[0].is_none() {
+            slots[0] = Some(shading_pipeline(ctx, model, false)?);
+        }
+        if brute_force && slots[1].is_none() {
+            slots[1] = Some(shading_pipeline(ctx, model, true)?);
+        }
+        Ok(())
+    }
+
+    /// Clears the colour target and the work counters and rasterises the mesh into the G-buffer.
+    pub fn record_surface(&self, rec: &mut Recorder, inputs: &ShadeInputs, constants: &ShadeConstants) -> Result<()> {
         rec.fill_buffer(inputs.work, 0)?;
         rec.begin_rendering(&[(inputs.color, Some([0.0; 4]))], None, 0)?;
         rec.end_rendering();
-        rec.begin_rendering(&[], Some((inputs.depth, Some(1.0))), 0)?;
+        let targets = [(inputs.position, Some([0.0; 4])), (inputs.normal, Some([0.0; 4]))];
+        rec.begin_rendering(&targets, Some((inputs.depth, Some(1.0))), 0)?;
         let (v, i) = (Some(inputs.vertices), Some(inputs.indices));
-        rec.draw(&self.depth_prepass, &[], vk::bytes_of(view_projection), v, i, inputs.index_count, 1)?;
+        rec.draw(&self.surface, &[], vk::bytes_of(constants), v, i, inputs.index_count, 1)?;
         rec.end_rendering();
         Ok(())
     }
 
     /// Shades one unit: its rectangle, over its range of points for brute force (added by
-    /// blending to what earlier ranges left), else by walking the tree.
+    /// blending to what earlier ranges left), else by walking the tree. `prepare` made the
+    /// pipelines of `model`.
     pub fn record_unit(
         &self,
         rec: &mut Recorder,
         inputs: &ShadeInputs,
         constants: &ShadeConstants,
         unit: &ShadeUnit,
+        model: u32,
     ) -> Result<()> {
         let binds = [
-            Bind::Read(inputs.params),
+            Bind::Uniform(inputs.params),
             Bind::Read(inputs.nodes),
             Bind::Read(inputs.points),
             Bind::Write(inputs.work),
@@ -210,20 +234,21 @@ impl ShadePass {
             Bind::Sampled(inputs.shadow_map, inputs.shadow_sampler),
             Bind::Read(inputs.point_lights),
             Bind::Read(inputs.node_lights),
+            Bind::StorageImageRead(inputs.position),
+            Bind::StorageImageRead(inputs.normal),
         ];
         let mut c = *constants;
         c.point_range = glam::UVec4::new(unit.first_point, unit.point_count, 0, 0);
-        let pipeline = if unit.point_count > 0 { &self.additive } else { &self.pipeline };
+        let additive = unit.point_count > 0;
+        let pipeline = self.shading[model as usize][additive as usize]
+            .as_ref()
+            .ok_or_else(|| crate::runtime!("shade: the pipeline for model {model} was not prepared"))?;
         // One rendering scope per unit: every draw writes the work counters, and the barrier
         // between two writes cannot sit inside a rendering scope.
         rec.prepare_draw_reads(&binds)?;
-        rec.begin_rendering(&[(inputs.color, None)], Some((inputs.depth, None)), 0)?;
+        rec.begin_rendering(&[(inputs.color, None)], None, 0)?;
         rec.set_scissor(unit.x, unit.y, unit.width, unit.height);
-        // The pre-pass clears stencil to 0 and each draw over a pixel adds one: the draw of the
-        // k-th range of points expects k (mod 256, the stencil wraps).
-        rec.set_stencil_reference((unit.first_point / POINTS_PER_DRAW) & 0xff);
-        let (v, i) = (Some(inputs.vertices), Some(inputs.indices));
-        rec.draw(pipeline, &binds, vk::bytes_of(&c), v, i, inputs.index_count, 1)?;
+        rec.draw(pipeline, &binds, vk::bytes_of(&c), None, None, 3, 1)?;
         rec.end_rendering();
         Ok(())
     }

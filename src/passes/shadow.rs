@@ -66,6 +66,7 @@ impl ShadowPass {
                 depth_bias: true,
                 cull_mode: CullModeFlags::NONE,
                 additive_blend: false,
+                specialization: &[],
                 bindings: &[],
                 push_constant_size: 64,
             },

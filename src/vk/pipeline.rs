@@ -177,16 +177,24 @@ impl Pipeline {
         let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
         let (set_layout, layout) = layouts(ctx, desc.bindings, desc.push_constant_size, stages)?;
 
+        // Specialisation constant i (constant_id = i) of both stages is desc.specialization[i].
+        let entries: Vec<vk::SpecializationMapEntry> = (0..desc.specialization.len() as u32)
+            .map(|i| vk::SpecializationMapEntry { constant_id: i, offset: 4 * i, size: 4 })
+            .collect();
+        let specialization =
+            vk::SpecializationInfo::default().map_entries(&entries).data(bytemuck::cast_slice(desc.specialization));
         let mut stage_infos = vec![vk::PipelineShaderStageCreateInfo::default()
             .stage(vk::ShaderStageFlags::VERTEX)
             .module(vert.raw)
-            .name(c"main")];
+            .name(c"main")
+            .specialization_info(&specialization)];
         if let Some(frag) = &frag {
             stage_infos.push(
                 vk::PipelineShaderStageCreateInfo::default()
                     .stage(vk::ShaderStageFlags::FRAGMENT)
                     .module(frag.raw)
-                    .name(c"main"),
+                    .name(c"main")
+                    .specialization_info(&specialization),
             );
         }
         let vertex_bindings = [vk::VertexInputBindingDescription {
@@ -328,6 +336,8 @@ pub struct GraphicsDesc<'a> {
     pub depth_bias: bool,
     pub cull_mode: vk::CullModeFlags,
     pub additive_blend: bool,
+    /// Values of the shaders' specialisation constants, by constant_id (0, 1, ...).
+    pub specialization: &'a [u32],
     pub bindings: &'a [BindingKind],
     pub push_constant_size: u32,
 }

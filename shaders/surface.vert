@@ -1,13 +1,11 @@
 #version 460
+// The surface pass: the mesh rasterised once, to the G-buffer the shade pass reads.
 #include "shade_constants.glsl"
 
 layout(location = 0) in vec3 in_position;
 layout(location = 1) in vec3 in_normal;
 
 layout(location = 0) out vec3 world_position;
-// The depth pre-pass (hierarchy/shadow.vert) computes the same position: EQUAL depth testing
-// needs both to round identically.
-invariant gl_Position;
 layout(location = 1) out vec3 world_normal;
 
 void main() {
