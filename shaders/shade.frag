@@ -14,6 +14,7 @@
 #include "subsurface_params.glsl"
 #include "lights.glsl"
 #include "microfacet.glsl"
+#include "tile_lists.glsl"
 
 // The model, fixed per pipeline: llvmpipe runs both sides of a branch for every SIMD group, so a
 // model chosen at run time would cost both models' arithmetic (measured: the classical dipole
@@ -24,18 +25,25 @@ layout(location = 0) out vec4 radiance;
 
 // A uniform buffer: llvmpipe loads its members once per SIMD group (storage buffers per lane).
 layout(std140, binding = 0) uniform Params { SubsurfaceParams params; };
-layout(std430, binding = 1) readonly buffer Nodes { TreeNode nodes[]; };
-layout(std430, binding = 2) readonly buffer Sorted { SurfacePoint points[]; };
+// The tree's records as texels (see points.glsl): TreeNode, SurfacePoint (sorted).
+layout(binding = 1) uniform usamplerBuffer nodes;
+layout(binding = 2) uniform usamplerBuffer points;
 // Work per pixel for --profile: sums and maxima of nodes visited and points evaluated.
 // Sd evaluations: calls of source(), each for three channels (a node used whole is two per light).
 layout(std430, binding = 3) buffer WorkCounters { uint pixels; uint node_sum; uint node_max; uint point_sum; uint point_max; uint evaluation_sum; } work;
 layout(std430, binding = 4) readonly buffer Lights { LightSet light_set; mat4 layer_matrices[]; };
 layout(binding = 5) uniform sampler2DArrayShadow shadow_map;
-layout(std430, binding = 6) readonly buffer SortedPointLights { PointLight point_lights[]; };
-layout(std430, binding = 7) readonly buffer NodeLights { NodeLight node_lights[]; };
+// Per-light records as texels: PointLight (sorted), NodeLight.
+layout(binding = 6) uniform usamplerBuffer point_lights;
+layout(binding = 7) uniform usamplerBuffer node_lights;
 // The surface pass's G-buffer: world position (w = 1 where covered) and interpolated normal.
 layout(binding = 8, rgba32f) uniform readonly image2D surface_position;
 layout(binding = 9, rgba32f) uniform readonly image2D surface_normal;
+// The tile-cut pass's lists (see tile_lists.glsl): a header texel per tile, entries 4 per texel.
+layout(binding = 10) uniform usamplerBuffer tile_headers;
+layout(binding = 11) uniform usamplerBuffer tile_entries;
+// The classical dipole's Sd per channel, tabulated (bssrdf.glsl).
+layout(binding = 12) uniform usamplerBuffer dipole_table;
 
 const uint STACK_SIZE = 96u;
 // Stack entries: a point or node index (below 2^24, with LEAF_BIT for points) and the number of
@@ -58,19 +66,51 @@ vec3 source(vec3 xi, vec3 ni, vec3 wi, vec3 power, vec3 xo, vec3 no) {
                   dirpole_channel_sd(params.channels[1], g, xi_mm, xo_mm, no),
                   dirpole_channel_sd(params.channels[2], g, xi_mm, xo_mm, no));
     } else {
-        float r = length(xo - xi) * s;
-        sd = vec3(dipole_sd(params.channels[0], r), dipole_sd(params.channels[1], r), dipole_sd(params.channels[2], r));
+        sd = dipole_sd_table(dipole_table, params.dipole_reach, length(xo - xi) * s);
     }
     return sd * power * (s * s); // power is irradiance × scene-unit area: to mm²
 }
 
 // One light's record of one point: record = point · light_count + light.
-vec3 point_light_source(uint record, vec3 xo, vec3 no) {
-    PointLight l = point_lights[record];
-    if (l.irradiance == vec3(0.0)) return vec3(0.0);
-    SurfacePoint p = points[record / light_set.light_count];
-    return source(p.position, p.normal, decode_oct(l.toward_oct), l.irradiance * p.area, xo, no);
+vec3 point_light_source(uint record, uint light_count, vec3 xo, vec3 no) {
+    uvec4 l = texel(point_lights, record);
+    vec3 irradiance = uintBitsToFloat(l.xyz);
+    if (irradiance == vec3(0.0)) return vec3(0.0);
+    uint point = record / light_count;
+    vec4 position_area = texel_float(points, point * POINT_TEXELS);
+    vec3 normal = texel_float(points, point * POINT_TEXELS + 1u).xyz;
+    return source(position_area.xyz, normal, decode_oct(l.w), irradiance * position_area.w, xo, no);
 }
+
+// The parameters of one source: point `index` for light k.
+void point_source(uint index, uint k, uint light_count, out vec3 xi, out vec3 power, out uint toward_oct) {
+    uvec4 l = texel(point_lights, index * light_count + k);
+    vec4 position_area = texel_float(points, index * POINT_TEXELS);
+    xi = position_area.xyz;
+    power = uintBitsToFloat(l.xyz) * position_area.w;
+    toward_oct = l.w;
+}
+
+// The parameters of one source: node `index` used whole, light k, sigma point `second` (0 or 1).
+// A node used whole is not one source at its power centre c: Sd is convex in distance, so that
+// underestimates it (1-1.5% on a slab). Two sigma points c ± s(u + t), s² = spread²/2 per axis of
+// the node's tangent plane (u toward xo, t across), match the points' mean and second moments, so
+// Sd's curvature along u and t is taken into account to second order.
+void node_source(uint index, uint k, uint second, uint light_count, vec3 ni, vec3 xo, out vec3 xi,
+                 out vec3 power, out uint toward_oct) {
+    uint record = (index * light_count + k) * NODE_LIGHT_TEXELS;
+    uvec4 power_toward = texel(node_lights, record);
+    vec4 center_spread = texel_float(node_lights, record + 1u);
+    vec3 towards_xo = xo - center_spread.xyz;
+    vec3 u = towards_xo - ni * dot(towards_xo, ni);
+    u = dot(u, u) > 0.0 ? normalize(u) : normalize(cross(ni, abs(ni.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0)));
+    vec3 offset = sqrt(0.5 * center_spread.w) * (u + cross(ni, u));
+    xi = center_spread.xyz + (second != 0u ? -offset : offset);
+    power = 0.5 * uintBitsToFloat(power_toward.xyz);
+    toward_oct = power_toward.w;
+}
+
+uint tile_entry(uint i) { return texel(tile_entries, i >> 2)[i & 3u]; }
 
 // Σ over lights of f_spec(wi, wo) · E · cos θi · visibility.
 vec3 specular(vec3 xo, vec3 no, vec3 wo) {
@@ -110,90 +150,109 @@ void main() {
         // silently ends a shader invocation's loops after ~65k iterations in total, so no draw
         // may loop longer.
         uint end = min(pc.point_range.x + pc.point_range.y, params.point_count * light_count);
-        for (uint r = pc.point_range.x; r < end; ++r) sum += point_light_source(r, xo, no);
+        for (uint r = pc.point_range.x; r < end; ++r) sum += point_light_source(r, light_count, xo, no);
         evaluated = end > pc.point_range.x ? end - pc.point_range.x : 0u;
         evaluations = evaluated;
     } else {
-        // Points are pushed like nodes, so that each step evaluates at most one source at one
-        // place in the code: the lanes of a SIMD group (llvmpipe) or warp (GPU) that evaluate in
-        // a step do it together, whether their source is a node or a point.
+        // The tile's list (tile_cut.comp): every lane of the tile runs the same evaluations in
+        // the same order, one loop iteration each, so the lanes of a SIMD group or warp stay
+        // together and load the same records.
+        uint tiles_across = (uint(imageSize(surface_position).x) + TILE_SIZE - 1u) / TILE_SIZE;
+        uvec4 tile = texel(tile_headers, (uint(pixel.y) / TILE_SIZE) * tiles_across + uint(pixel.x) / TILE_SIZE);
+        uint entry = tile.x;
+        for (uint e = 0u; e < tile.y * light_count; ++e) {
+            uint index = tile_entry(entry + e / light_count);
+            vec3 xi, power;
+            uint toward_oct;
+            point_source(index, e % light_count, light_count, xi, power, toward_oct);
+            if (power == vec3(0.0)) continue;
+            ++evaluations;
+            vec3 ni = texel_float(points, index * POINT_TEXELS + 1u).xyz;
+            sum += source(xi, ni, decode_oct(toward_oct), power, xo, no);
+        }
+        evaluated += tile.y;
+        entry += tile.y;
+        for (uint e = 0u; e < tile.z * 2u * light_count; ++e) {
+            uint index = tile_entry(entry + e / (2u * light_count));
+            vec3 ni = decode_oct(texel(nodes, index * NODE_TEXELS + 3u).x);
+            vec3 xi, power;
+            uint toward_oct;
+            node_source(index, (e / 2u) % light_count, e & 1u, light_count, ni, xo, xi, power, toward_oct);
+            if (power == vec3(0.0)) continue;
+            ++evaluations;
+            sum += source(xi, ni, decode_oct(toward_oct), power, xo, no);
+        }
+        visits += tile.z;
+        entry += tile.z;
+
+        // Frontier nodes: each pixel walks them with its own stack, as the walk without tiles
+        // did from the root. Points are pushed like nodes, so that each step evaluates at most
+        // one source at one place in the code: the lanes of a SIMD group (llvmpipe) or warp (GPU)
+        // that evaluate in a step do it together, whether their source is a node or a point.
         // Stack entries are a point or node and, in bits 24-28, which of its evaluations is
         // next: 0 for a fresh entry (test it first), e + 1 for evaluation e. A source's
         // evaluations (one per light for a point, two sigma points per light for a node) are
-        // steps of this one loop, each pushing the next: lanes of a SIMD group or warp step
-        // together, so those that evaluate do it at the same place, whatever their source.
-        uint stack[STACK_SIZE];
-        uint top = 0u;
-        stack[top++] = 0u;
-        uint steps = 0u;
-        while (top > 0u) {
-            uint entry = stack[--top];
-            ++steps;
-            uint next = (entry >> EVALUATION_SHIFT) & EVALUATION_MASK;
-            uint item = entry & ~(EVALUATION_MASK << EVALUATION_SHIFT);
-            bool is_point = (item & LEAF_BIT) != 0u;
-            uint index = item & ~LEAF_BIT;
-            vec3 ni;
-            if (is_point) {
-                ni = points[index].normal;
-                if (next == 0u) {
-                    ++evaluated;
-                    if (points[index].irradiance == vec3(0.0)) continue;
-                }
-            } else {
-                // A continuation needs only the node's normal: the rest is loaded on its first visit.
-                ni = decode_oct(nodes[index].normal_oct);
-                if (next == 0u) {
-                    TreeNode node = nodes[index];
-                    ++visits;
-                    if (node.power == vec3(0.0)) continue;
-                    vec3 lo, hi;
-                    unpack_box(node.box_half, lo, hi);
-                    vec3 d = node.center - xo;
-                    bool inside = all(greaterThanEqual(xo, lo)) && all(lessThanEqual(xo, hi));
-                    // A full stack or a spent step budget (see above) ends the descent: the node
-                    // is then used whole, an approximation rather than a silently truncated sum.
-                    bool must_stop = top + 2u > STACK_SIZE || steps > MAX_STEPS;
-                    if (inside || node.area >= params.epsilon * dot(d, d)) {
-                        if (!must_stop) {
-                            stack[top++] = node.left;
-                            stack[top++] = node.right;
-                            continue;
+        // steps of this one loop, each pushing the next.
+        bool from_root = tile.w == WALK_FROM_ROOT;
+        uint frontier_count = from_root ? 1u : tile.w;
+        uint steps = evaluations;
+        for (uint f = 0u; f < frontier_count; ++f) {
+            uint stack[STACK_SIZE];
+            uint top = 0u;
+            stack[top++] = from_root ? 0u : tile_entry(entry + f);
+            while (top > 0u) {
+                uint item_entry = stack[--top];
+                ++steps;
+                uint next = (item_entry >> EVALUATION_SHIFT) & EVALUATION_MASK;
+                uint item = item_entry & ~(EVALUATION_MASK << EVALUATION_SHIFT);
+                bool is_point = (item & LEAF_BIT) != 0u;
+                uint index = item & ~LEAF_BIT;
+                vec3 ni;
+                if (is_point) {
+                    ni = texel_float(points, index * POINT_TEXELS + 1u).xyz;
+                    if (next == 0u) {
+                        ++evaluated;
+                        if (texel_float(points, index * POINT_TEXELS + 2u).xyz == vec3(0.0)) continue;
+                    }
+                } else {
+                    // A continuation needs only the node's normal: the rest is loaded on its first visit.
+                    ni = decode_oct(texel(nodes, index * NODE_TEXELS + 3u).x);
+                    if (next == 0u) {
+                        vec4 power_area = texel_float(nodes, index * NODE_TEXELS);
+                        uvec4 center_left = texel(nodes, index * NODE_TEXELS + 1u);
+                        uvec4 box_right = texel(nodes, index * NODE_TEXELS + 2u);
+                        ++visits;
+                        if (power_area.xyz == vec3(0.0)) continue;
+                        vec3 lo, hi;
+                        unpack_box(box_right.xyz, lo, hi);
+                        vec3 d = uintBitsToFloat(center_left.xyz) - xo;
+                        bool inside = all(greaterThanEqual(xo, lo)) && all(lessThanEqual(xo, hi));
+                        // A full stack or a spent step budget (see above) ends the descent: the
+                        // node is then used whole, an approximation rather than a silently
+                        // truncated sum.
+                        bool must_stop = top + 2u > STACK_SIZE || steps > MAX_STEPS;
+                        if (inside || power_area.w >= params.epsilon * dot(d, d)) {
+                            if (!must_stop) {
+                                stack[top++] = center_left.w;
+                                stack[top++] = box_right.w;
+                                continue;
+                            }
                         }
                     }
                 }
+                uint evaluation = next == 0u ? 0u : next - 1u;
+                uint per_light = is_point ? 1u : 2u;
+                // The rest of this source's evaluations, after this one (it took this entry's place).
+                if (evaluation + 1u < per_light * light_count) stack[top++] = item | ((evaluation + 2u) << EVALUATION_SHIFT);
+                uint k = evaluation / per_light;
+                vec3 xi, power;
+                uint toward_oct;
+                if (is_point) point_source(index, k, light_count, xi, power, toward_oct);
+                else node_source(index, k, evaluation & 1u, light_count, ni, xo, xi, power, toward_oct);
+                if (power == vec3(0.0)) continue;
+                ++evaluations;
+                sum += source(xi, ni, decode_oct(toward_oct), power, xo, no);
             }
-            uint evaluation = next == 0u ? 0u : next - 1u;
-            uint per_light = is_point ? 1u : 2u;
-            // The rest of this source's evaluations, after this one (it took this entry's place).
-            if (evaluation + 1u < per_light * light_count) stack[top++] = item | ((evaluation + 2u) << EVALUATION_SHIFT);
-            uint k = evaluation / per_light;
-            vec3 center, power, offset = vec3(0.0);
-            uint toward_oct;
-            if (is_point) {
-                PointLight l = point_lights[index * light_count + k];
-                center = points[index].position;
-                power = l.irradiance * points[index].area;
-                toward_oct = l.toward_oct;
-            } else {
-                // A node used whole is not one source at its power centre c: Sd is convex in
-                // distance, so that underestimates it (1-1.5% on a slab). Two sigma points
-                // c ± s(u + t), s² = spread²/2 per axis of the node's tangent plane (u toward xo,
-                // t across), match the points' mean and second moments, so Sd's curvature along
-                // u and t is taken into account to second order.
-                NodeLight l = node_lights[index * light_count + k];
-                center = l.power_center;
-                power = 0.5 * l.power;
-                toward_oct = l.toward_oct;
-                vec3 towards_xo = xo - center;
-                vec3 u = towards_xo - ni * dot(towards_xo, ni);
-                u = dot(u, u) > 0.0 ? normalize(u) : normalize(cross(ni, abs(ni.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0)));
-                offset = sqrt(0.5 * l.spread2) * (u + cross(ni, u));
-                if ((evaluation & 1u) != 0u) offset = -offset;
-            }
-            if (power == vec3(0.0)) continue;
-            ++evaluations;
-            sum += source(center + offset, ni, decode_oct(toward_oct), power, xo, no);
         }
     }
     // Helper invocations' atomics have no effect (Vulkan spec), so only real pixels count.

@@ -9,7 +9,9 @@ use crate::materials::Material;
 use crate::output::{self, Exposure, HdrImage};
 use crate::passes::debug_view::{self, DebugConstants, DebugViewPass};
 use crate::passes::shade::{self, ShadeConstants, ShadeInputs, ShadePass, SubsurfaceParams, WorkCounters};
+use crate::passes::tile_cut::{TileCutPass, TileLists};
 use crate::passes::tonemap::{self, TonemapPass};
+use crate::physics::dipole::{self, SdTable};
 use crate::physics::{Diffusion, GpuChannel, Model};
 use crate::scene::Scene;
 use crate::vk::{
@@ -35,6 +37,11 @@ fn shade_whole_frame(whole_frame: bool, submissions: usize, seconds: f64, target
     }
 }
 
+/// The classical dipole's Sd table for the material of `o`.
+fn dipole_table(o: &SubsurfaceOptions) -> SdTable {
+    SdTable::new(&[0, 1, 2].map(|c| o.material.channel(c).constants(o.diffusion)))
+}
+
 fn subsurface_params(o: &SubsurfaceOptions, mm_per_unit: f32, point_count: u32) -> SubsurfaceParams {
     let channel = |c: usize| GpuChannel::from(&o.material.channel(c).constants(o.diffusion));
     SubsurfaceParams {
@@ -51,7 +58,8 @@ fn subsurface_params(o: &SubsurfaceOptions, mm_per_unit: f32, point_count: u32) 
         count_work: 0,
         specular: o.specular as u32,
         roughness: o.roughness,
-        pad: [0; 3],
+        dipole_reach: dipole_table(o).reach as f32,
+        pad: [0; 2],
     }
 }
 
@@ -82,8 +90,20 @@ macro_rules! shade_inputs {
             shadow_sampler: &$r.hierarchy.shadow_sampler,
             point_lights: &$r.hierarchy.sorted_point_lights,
             node_lights: &$r.hierarchy.node_lights,
+            tile_headers: &$r.tile_lists.headers,
+            tile_entries: &$r.tile_lists.entries,
+            dipole_table: &$r.dipole_table,
         }
     };
+}
+
+/// Records the tile-cut pass (a macro for the same reason as `shade_inputs`).
+macro_rules! record_tile_cut {
+    ($r:expr, $rec:expr) => {{
+        let h = &$r.hierarchy;
+        let (params, lists) = (&$r.subsurface_params, &$r.tile_lists);
+        $r.tile_cut.record($rec, params, &h.nodes, &h.sorted_points, &$r.position, lists, h.light_count)
+    }};
 }
 
 /// A frame between [`Renderer::begin_frame`] and [`Renderer::finish_frame`].
@@ -170,11 +190,16 @@ pub struct Renderer {
     profiler: Option<GpuProfiler>,
     pub hierarchy: Hierarchy,
     subsurface_params: Buffer,
+    /// The classical dipole's Sd table (texels), for the material of `subsurface_params`.
+    dipole_table: Buffer,
     /// Nodes and points per pixel, counted on the GPU when profiling.
     work_counters: Buffer,
     brute_force: bool,
     /// The model's GPU code (`SubsurfaceParams::model`): which shading pipeline draws.
     model: u32,
+    tile_cut: TileCutPass,
+    /// The per-tile source lists, sized for the frame and grown when a frame needs more.
+    tile_lists: TileLists,
     shade: ShadePass,
     /// The lights the hierarchy was last given (re-sent only when they change).
     lights: Vec<crate::scene::Light>,
@@ -263,6 +288,8 @@ impl Renderer {
             MemoryLocation::GpuOnly,
         )?;
         let shade = ShadePass::new(&ctx)?;
+        let tile_cut = TileCutPass::new(&ctx)?;
+        let tile_lists = TileLists::new(&ctx, width, height, None)?;
         let hierarchy = Hierarchy::new(&ctx, &scene.mesh, &scene.lights, &hierarchy)?;
         let mut params = subsurface_params(&subsurface, scene.mm_per_unit, hierarchy.point_count);
         params.count_work = count_work as u32;
@@ -281,13 +308,24 @@ impl Renderer {
             MemoryLocation::CpuToGpu,
         )?;
         subsurface_params.write(0, &[params])?;
+        let mut dipole_table = Buffer::new(
+            &ctx,
+            "dipole Sd table",
+            (dipole::TABLE_SIZE * 16) as u64,
+            BufferUsageFlags::UNIFORM_TEXEL_BUFFER,
+            MemoryLocation::CpuToGpu,
+        )?;
+        dipole_table.write(0, &self::dipole_table(&subsurface).values)?;
         Ok(Renderer {
             profiler,
             hierarchy,
             subsurface_params,
+            dipole_table,
             work_counters,
             brute_force: subsurface.brute_force,
             model: params.model,
+            tile_cut,
+            tile_lists,
             shade,
             lights: scene.lights.clone(),
             tile: DEFAULT_TILE,
@@ -333,6 +371,7 @@ impl Renderer {
         let Targets { color, depth, position, normal, readback, ldr } = Targets::new(&self.ctx, extent)?;
         (self.color, self.depth, self.position, self.normal) = (color, depth, position, normal);
         (self.readback, self.ldr, self.extent) = (readback, ldr, extent);
+        self.tile_lists = TileLists::new(&self.ctx, width, height, None)?;
         // Learn again whether a frame of this size fits one submission.
         if !self.tile_fixed {
             self.whole_frame = false;
@@ -365,6 +404,7 @@ impl Renderer {
         let mut params = subsurface_params(subsurface, mm_per_unit, self.hierarchy.point_count);
         params.count_work = count_work;
         self.subsurface_params.write(0, &[params])?;
+        self.dipole_table.write(0, &dipole_table(subsurface).values)?;
         self.brute_force = subsurface.brute_force;
         self.model = params.model;
         self.hierarchy.set_eta(subsurface.material.eta as f32)
@@ -499,8 +539,9 @@ impl Renderer {
         let inputs = shade_inputs!(self);
 
         // The frame, in order: the hierarchy (sampling, shadow maps, irradiance, Morton codes,
-        // sort, tree build, summaries; each its own scope), the surface pass (G-buffer), shading
-        // in tiles, debug views, then read-back.
+        // sort, tree build, summaries; each its own scope), the surface pass (G-buffer), the
+        // tile cut, shading in tiles, debug views, then read-back.
+        let cut = self.show == Show::Shading && !self.brute_force;
         if let Some(p) = self.profiler.as_mut() {
             p.begin_frame();
         }
@@ -509,8 +550,29 @@ impl Renderer {
             rec.begin_scope("surface");
             self.shade.record_surface(rec, &inputs, &constants)?;
             rec.end_scope();
+            if cut {
+                rec.begin_scope("tile cut");
+                record_tile_cut!(self, rec)?;
+                rec.end_scope();
+            } else {
+                // Brute force reads no lists; still, nothing the shader may load is left undefined.
+                rec.fill_buffer(&self.tile_lists.headers, 0)?;
+            }
             Ok(())
         })?;
+        if cut {
+            if let Some(lists) = self.tile_lists.grown(&self.ctx)? {
+                // Some tiles' lists did not fit (they would walk from the root): cut again into
+                // lists as big as this frame needs.
+                self.tile_lists = lists;
+                self.ctx.submit(self.profiler.as_mut(), |rec| {
+                    rec.begin_scope("tile cut");
+                    record_tile_cut!(self, rec)?;
+                    rec.end_scope();
+                    Ok(())
+                })?;
+            }
+        }
         Ok(FrameInProgress {
             view_projection,
             constants,

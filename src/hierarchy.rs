@@ -133,7 +133,8 @@ const NODE_LIGHT_BYTES: u64 = std::mem::size_of::<NodeLight>() as u64;
 /// The largest sample count the device can hold with `lights` lights: each buffer within
 /// `maxStorageBufferRange`.
 pub fn max_points(ctx: &Context, lights: u32) -> u32 {
-    let range = ctx.limits().max_storage_buffer_range as u64;
+    // Storage buffers, and the shade pass's texel views of them (16-byte texels).
+    let range = (ctx.limits().max_storage_buffer_range as u64).min(ctx.limits().max_texel_buffer_elements as u64 * 16);
     // The largest per-point buffers are the points and nodes (64 bytes per element) and the
     // nodes' light records (32 bytes per light); the radix count table is about 4 bytes per key.
     // The walk's stack entries hold a point or node index in 24 bits (shaders/shade.frag).
@@ -210,14 +211,11 @@ impl Hierarchy {
         }
         let light_count = lights.len() as u32;
         check_point_count(ctx, n, light_count)?;
-        let storage = |name: &str, bytes: u64| {
-            Buffer::new(
-                ctx,
-                name,
-                bytes,
-                BufferUsageFlags::STORAGE_BUFFER | BufferUsageFlags::TRANSFER_SRC | BufferUsageFlags::TRANSFER_DST,
-                MemoryLocation::GpuOnly,
-            )
+        let usage = BufferUsageFlags::STORAGE_BUFFER | BufferUsageFlags::TRANSFER_SRC | BufferUsageFlags::TRANSFER_DST;
+        let storage = |name: &str, bytes: u64| Buffer::new(ctx, name, bytes, usage, MemoryLocation::GpuOnly);
+        // What the shade pass reads is also read as texels (see shaders/include/points.glsl).
+        let texels = |name: &str, bytes: u64| {
+            Buffer::new(ctx, name, bytes, usage | BufferUsageFlags::UNIFORM_TEXEL_BUFFER, MemoryLocation::GpuOnly)
         };
         let n64 = n as u64;
         let tiles = n.div_ceil(TILE) as u64;
@@ -237,11 +235,11 @@ impl Hierarchy {
             keys: [storage("morton keys A", n64 * 8)?, storage("morton keys B", n64 * 8)?],
             values: [storage("sort order A", n64 * 4)?, storage("sort order B", n64 * 4)?],
             counts: storage("radix counts", tiles * 256 * 4)?,
-            sorted_points: storage("sorted points", n64 * 64)?,
-            nodes: storage("tree nodes", (n64 - 1) * 64)?,
+            sorted_points: texels("sorted points", n64 * 64)?,
+            nodes: texels("tree nodes", (n64 - 1) * 64)?,
             point_lights: storage("point light records", n64 * light_count as u64 * 16)?,
-            sorted_point_lights: storage("sorted point light records", n64 * light_count as u64 * 16)?,
-            node_lights: storage("node light records", (n64 - 1) * light_count as u64 * NODE_LIGHT_BYTES)?,
+            sorted_point_lights: texels("sorted point light records", n64 * light_count as u64 * 16)?,
+            node_lights: texels("node light records", (n64 - 1) * light_count as u64 * NODE_LIGHT_BYTES)?,
             node_parent: storage("node parents", (n64 - 1) * 4)?,
             point_parent: storage("point parents", n64 * 4)?,
             arrivals: storage("node arrival counters", (n64 - 1) * 4)?,

@@ -33,13 +33,14 @@ fn subsurface_params_and_tree_match_glsl() {
         offset_of!(SubsurfaceParams, count_work),
         offset_of!(SubsurfaceParams, specular),
         offset_of!(SubsurfaceParams, roughness),
+        offset_of!(SubsurfaceParams, dipole_reach),
     ]
     .iter()
     .map(|&o| o as u32)
     .collect();
     assert_eq!(params[..rust.len()], rust[..]);
     assert_eq!(size_of::<SubsurfaceParams>(), 240);
-    let node = member_offsets("shade.frag", "TreeNode").expect("TreeNode");
+    let node = member_offsets("hierarchy/tree_aggregate.comp", "TreeNode").expect("TreeNode");
     let rust: Vec<u32> = [
         offset_of!(TreeNode, power),
         offset_of!(TreeNode, area),
@@ -57,7 +58,7 @@ fn subsurface_params_and_tree_match_glsl() {
     .collect();
     assert_eq!(node, rust);
     assert_eq!(size_of::<TreeNode>(), 64);
-    let point = member_offsets("shade.frag", "SurfacePoint").expect("SurfacePoint");
+    let point = member_offsets("hierarchy/tree_aggregate.comp", "SurfacePoint").expect("SurfacePoint");
     let rust: Vec<u32> = [
         offset_of!(SurfacePoint, position),
         offset_of!(SurfacePoint, area),
@@ -78,10 +79,10 @@ fn subsurface_params_and_tree_match_glsl() {
 #[test]
 fn light_records_match_glsl() {
     use translucent::hierarchy::{NodeLight, PointLight};
-    let point = member_offsets("shade.frag", "PointLight").expect("PointLight");
+    let point = member_offsets("hierarchy/tree_aggregate.comp", "PointLight").expect("PointLight");
     assert_eq!(point, [offset_of!(PointLight, irradiance), offset_of!(PointLight, toward_oct)].map(|o| o as u32));
     assert_eq!(size_of::<PointLight>(), 16);
-    let node = member_offsets("shade.frag", "NodeLight").expect("NodeLight");
+    let node = member_offsets("hierarchy/tree_aggregate.comp", "NodeLight").expect("NodeLight");
     let rust = [
         offset_of!(NodeLight, power),
         offset_of!(NodeLight, toward_oct),
@@ -140,4 +141,17 @@ fn tonemap_structs_match_glsl() {
     assert_eq!(constants, rust);
     let histogram = member_offsets("tonemap.comp", "Histogram").expect("Histogram");
     assert_eq!(histogram.last().copied(), Some(HISTOGRAM_HEADER_BYTES as u32), "bins follow the header");
+}
+
+/// Constants the shaders and Rust share, written in both: the tile lists' and the dipole table's.
+#[test]
+fn shared_constants_match_glsl() {
+    let read = |path: &str| std::fs::read_to_string(format!("{}/shaders/{path}", env!("CARGO_MANIFEST_DIR"))).unwrap();
+    let tiles = read("include/tile_lists.glsl");
+    let tile_size = translucent::passes::tile_cut::TILE_SIZE;
+    assert!(tiles.contains(&format!("const uint TILE_SIZE = {tile_size}u;")), "TILE_SIZE");
+    assert_eq!(translucent::passes::tile_cut::WALK_FROM_ROOT, u32::MAX);
+    assert!(tiles.contains("const uint WALK_FROM_ROOT = 0xffffffffu;"), "WALK_FROM_ROOT");
+    let table_size = translucent::physics::dipole::TABLE_SIZE;
+    assert!(read("include/bssrdf.glsl").contains(&format!("const uint DIPOLE_TABLE_SIZE = {table_size}u;")));
 }

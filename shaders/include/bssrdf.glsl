@@ -52,6 +52,18 @@ float dipole_sd(BssrdfChannel c, float r) {
     return c.dipole_scale * (real_term + virtual_term) * (1.0 / 3.14159265358979323846);
 }
 
+// The classical dipole's Sd per channel from its table (mirrors physics::dipole::SdTable):
+// entry i holds Sd at u = i/(DIPOLE_TABLE_SIZE - 1) of u = r/(r + reach), r in mm; linear
+// between entries. A lookup replaces 6 square roots, exponentials and divisions.
+const uint DIPOLE_TABLE_SIZE = 4096u;
+vec3 dipole_sd_table(usamplerBuffer table, float reach, float r) {
+    float x = r / (r + reach) * float(DIPOLE_TABLE_SIZE - 1u);
+    float i = min(floor(x), float(DIPOLE_TABLE_SIZE - 2u));
+    vec3 a = uintBitsToFloat(texelFetch(table, int(i)).xyz);
+    vec3 b = uintBitsToFloat(texelFetch(table, int(i) + 1).xyz);
+    return mix(a, b, x - i);
+}
+
 // The ray-source term S'(x, w, r) of the directional dipole.
 float dirpole_source(BssrdfChannel c, vec3 x, vec3 w, float r, vec3 no) {
     float s_r = c.sigma_tr * r;

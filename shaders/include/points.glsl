@@ -50,6 +50,19 @@ struct NodeLight {
     float spread2;     // power-weighted mean squared distance of the points from power_center
 };
 
+// The same records read as RGBA32UI texels (usamplerBuffer views of the same buffers, for the
+// shade pass: llvmpipe gathers texels as vectors but loads storage buffers one lane at a time).
+// Each record is a whole number of texels, in the order of its fields above:
+// SurfacePoint: 0 position, area; 1 normal, triangle; 2 irradiance; 3 light_dir.
+// TreeNode: 0 power, area; 1 center, left; 2 box_half, right; 3 normal_oct, light_oct,
+// first_point, point_count. PointLight: 0 irradiance, toward_oct. NodeLight: 0 power,
+// toward_oct; 1 power_center, spread2.
+const uint POINT_TEXELS = 4u;
+const uint NODE_TEXELS = 4u;
+const uint NODE_LIGHT_TEXELS = 2u;
+uvec4 texel(usamplerBuffer records, uint index) { return texelFetch(records, int(index)); }
+vec4 texel_float(usamplerBuffer records, uint index) { return uintBitsToFloat(texelFetch(records, int(index))); }
+
 // Octahedral encoding of a unit vector (Cigolle et al. 2014) into 2×16-bit snorm.
 vec2 oct_wrap(vec2 v) {
     return (1.0 - abs(v.yx)) * vec2(v.x >= 0.0 ? 1.0 : -1.0, v.y >= 0.0 ? 1.0 : -1.0);

@@ -7,5 +7,6 @@ pub mod sampling;
 pub mod shade;
 pub mod shadow;
 pub mod sort;
+pub mod tile_cut;
 pub mod tonemap;
 pub mod tree;

@@ -51,7 +51,9 @@ pub struct SubsurfaceParams {
     /// 1 to add the microfacet lobe.
     pub specular: u32,
     pub roughness: f32,
-    pub pad: [u32; 3],
+    /// The scale of the classical dipole's Sd table (`SdTable::reach`), mm.
+    pub dipole_reach: f32,
+    pub pad: [u32; 2],
 }
 
 /// Mirrors `WorkCounters` in shaders/shade.frag.
@@ -85,6 +87,11 @@ pub struct ShadeInputs<'a> {
     pub shadow_sampler: &'a Sampler,
     pub point_lights: &'a Buffer,
     pub node_lights: &'a Buffer,
+    /// The classical dipole's Sd table (`physics::dipole::SdTable`).
+    pub dipole_table: &'a Buffer,
+    /// The tile-cut pass's lists (headers and entries).
+    pub tile_headers: &'a Buffer,
+    pub tile_entries: &'a Buffer,
 }
 
 /// One piece of a frame's shading: a rectangle of pixels and, for brute force, a range of points.
@@ -148,15 +155,18 @@ fn shading_pipeline(ctx: &Context, model: u32, additive_blend: bool) -> Result<P
             specialization: &[model],
             bindings: &[
                 UniformBuffer,
-                StorageBuffer,
-                StorageBuffer,
+                TexelBuffer,
+                TexelBuffer,
                 StorageBuffer,
                 StorageBuffer,
                 SampledImage,
-                StorageBuffer,
-                StorageBuffer,
+                TexelBuffer,
+                TexelBuffer,
                 StorageImage,
                 StorageImage,
+                TexelBuffer,
+                TexelBuffer,
+                TexelBuffer,
             ],
             push_constant_size: std::mem::size_of::<ShadeConstants>() as u32,
         },
@@ -227,15 +237,18 @@ impl ShadePass {
     ) -> Result<()> {
         let binds = [
             Bind::Uniform(inputs.params),
-            Bind::Read(inputs.nodes),
-            Bind::Read(inputs.points),
+            Bind::Texels(inputs.nodes),
+            Bind::Texels(inputs.points),
             Bind::Write(inputs.work),
             Bind::Read(inputs.lights),
             Bind::Sampled(inputs.shadow_map, inputs.shadow_sampler),
-            Bind::Read(inputs.point_lights),
-            Bind::Read(inputs.node_lights),
+            Bind::Texels(inputs.point_lights),
+            Bind::Texels(inputs.node_lights),
             Bind::StorageImageRead(inputs.position),
             Bind::StorageImageRead(inputs.normal),
+            Bind::Texels(inputs.tile_headers),
+            Bind::Texels(inputs.tile_entries),
+            Bind::Texels(inputs.dipole_table),
         ];
         let mut c = *constants;
         c.point_range = glam::UVec4::new(unit.first_point, unit.point_count, 0, 0);

@@ -78,7 +78,11 @@ impl Commands {
                     ty: vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
                     descriptor_count: SETS_PER_SUBMIT * 2,
                 },
-                vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_IMAGE, descriptor_count: SETS_PER_SUBMIT },
+                vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_IMAGE, descriptor_count: SETS_PER_SUBMIT * 4 },
+                vk::DescriptorPoolSize {
+                    ty: vk::DescriptorType::UNIFORM_TEXEL_BUFFER,
+                    descriptor_count: SETS_PER_SUBMIT * 8,
+                },
             ];
             let descriptor_pool = device
                 .create_descriptor_pool(
@@ -107,6 +111,8 @@ pub enum Bind<'a> {
     /// Storage buffer the shader writes (and may read).
     Write(&'a Buffer),
     Uniform(&'a Buffer),
+    /// A buffer made with UNIFORM_TEXEL_BUFFER usage, read through its RGBA32UI texel view.
+    Texels(&'a Buffer),
     /// Combined image sampler, read in `SHADER_READ_ONLY_OPTIMAL`.
     Sampled(&'a Image, &'a Sampler),
     StorageImageRead(&'a Image),
@@ -344,6 +350,7 @@ impl<'a> Recorder<'a> {
                 (bind, kind),
                 (Bind::Read(_) | Bind::Write(_), BindingKind::StorageBuffer)
                     | (Bind::Uniform(_), BindingKind::UniformBuffer)
+                    | (Bind::Texels(_), BindingKind::TexelBuffer)
                     | (Bind::Sampled(..), BindingKind::SampledImage)
                     | (Bind::StorageImageRead(_) | Bind::StorageImageWrite(_), BindingKind::StorageImage)
             );
@@ -402,6 +409,7 @@ impl<'a> Recorder<'a> {
                         .descriptor_type(pipeline.bindings[i].descriptor_type());
                     match b {
                         Bind::Read(_) | Bind::Write(_) | Bind::Uniform(_) => w.buffer_info(&buffer_infos[i]),
+                        Bind::Texels(b) => w.texel_buffer_view(std::slice::from_ref(&b.texel_view)),
                         _ => w.image_info(&image_infos[i]),
                     }
                 })
@@ -609,6 +617,12 @@ impl<'a> Recorder<'a> {
             Bind::Write(b) if declared_write(b) => Ok(()),
             Bind::Write(b) => self.use_buffer(b, stage.write()),
             Bind::Uniform(b) => self.use_buffer(b, Access { stage: stage.flags(), ..Access::UNIFORM_READ }),
+            Bind::Texels(b) => {
+                if b.texel_view == vk::BufferView::null() {
+                    return Err(runtime!("buffer {} has no texel view (made without UNIFORM_TEXEL_BUFFER)", b.name));
+                }
+                self.use_buffer(b, Access { stage: stage.flags(), ..Access::TEXEL_READ })
+            }
             Bind::Sampled(img, _) => self.use_image(img, stage.sampled()),
             Bind::StorageImageRead(img) => self.use_image(img, stage.read()),
             Bind::StorageImageWrite(img) => self.use_image(img, stage.write()),

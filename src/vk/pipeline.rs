@@ -18,6 +18,8 @@ pub enum BindingKind {
     /// Combined image + sampler.
     SampledImage,
     StorageImage,
+    /// A buffer read as RGBA32UI texels (`usamplerBuffer`).
+    TexelBuffer,
 }
 
 impl BindingKind {
@@ -27,6 +29,7 @@ impl BindingKind {
             BindingKind::UniformBuffer => vk::DescriptorType::UNIFORM_BUFFER,
             BindingKind::SampledImage => vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
             BindingKind::StorageImage => vk::DescriptorType::STORAGE_IMAGE,
+            BindingKind::TexelBuffer => vk::DescriptorType::UNIFORM_TEXEL_BUFFER,
         }
     }
 }

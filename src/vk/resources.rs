@@ -89,6 +89,12 @@ impl Access {
         vk::AccessFlags2::INDIRECT_COMMAND_READ,
         vk::ImageLayout::UNDEFINED,
     );
+    /// A uniform texel buffer's reads (the stage is set per use).
+    pub const TEXEL_READ: Access = Access::new(
+        vk::PipelineStageFlags2::FRAGMENT_SHADER,
+        vk::AccessFlags2::SHADER_SAMPLED_READ,
+        vk::ImageLayout::UNDEFINED,
+    );
     pub const UNIFORM_READ: Access = Access::new(
         vk::PipelineStageFlags2::from_raw(
             vk::PipelineStageFlags2::VERTEX_SHADER.as_raw()
@@ -213,6 +219,10 @@ impl TrackedState {
 pub struct Buffer {
     shared: Arc<Shared>,
     pub(crate) raw: vk::Buffer,
+    /// A view of the whole buffer as RGBA32UI texels, made when its usage includes
+    /// UNIFORM_TEXEL_BUFFER (`Bind::Texels`): llvmpipe fetches texels with vector gathers, where
+    /// it loads storage buffers one lane at a time.
+    pub(crate) texel_view: vk::BufferView,
     allocation: Option<Allocation>,
     pub size: u64,
     pub name: String,
@@ -253,9 +263,35 @@ impl Buffer {
             let _ = ctx.shared.allocator.lock().unwrap().free(allocation);
             return Err(runtime!("vkBindBufferMemory {name}: {e}"));
         }
+        let mut texel_view = vk::BufferView::null();
+        if usage.contains(vk::BufferUsageFlags::UNIFORM_TEXEL_BUFFER) {
+            let texels = size / 16;
+            let max = ctx.limits().max_texel_buffer_elements as u64;
+            let view = if texels > max {
+                Err(runtime!("buffer {name}: {texels} texels exceed this device's {max} per texel buffer"))
+            } else {
+                let info = vk::BufferViewCreateInfo::default()
+                    .buffer(raw)
+                    .format(vk::Format::R32G32B32A32_UINT)
+                    .offset(0)
+                    .range(texels * 16);
+                // SAFETY: the buffer is bound to memory and made with UNIFORM_TEXEL_BUFFER usage.
+                unsafe { device.create_buffer_view(&info, None) }
+                    .map_err(|e| runtime!("vkCreateBufferView {name}: {e}"))
+            };
+            match view {
+                Ok(v) => texel_view = v,
+                Err(e) => {
+                    unsafe { device.destroy_buffer(raw, None) };
+                    let _ = ctx.shared.allocator.lock().unwrap().free(allocation);
+                    return Err(e);
+                }
+            }
+        }
         Ok(Buffer {
             shared: ctx.shared.clone(),
             raw,
+            texel_view,
             allocation: Some(allocation),
             size,
             name: name.to_string(),
@@ -306,7 +342,10 @@ impl Buffer {
 impl Drop for Buffer {
     fn drop(&mut self) {
         // SAFETY: the GPU is idle with respect to this buffer: every submission waits on its fence.
-        unsafe { self.shared.device.destroy_buffer(self.raw, None) };
+        unsafe {
+            self.shared.device.destroy_buffer_view(self.texel_view, None);
+            self.shared.device.destroy_buffer(self.raw, None);
+        }
         if let Some(a) = self.allocation.take() {
             let _ = self.shared.allocator.lock().unwrap().free(a);
         }

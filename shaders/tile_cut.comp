@@ -1,0 +1,119 @@
+#version 460
+// The cut per screen tile (TILE_SIZE² pixels): the sources that are far and small enough for
+// every pixel of the tile, found once, so that the shade pass's lanes for the tile (a SIMD group
+// on llvmpipe, a warp on a GPU) evaluate the same list in step instead of each walking the tree.
+// One invocation per tile: the tile's surface positions bound a box T; walking from the root, a
+// node is used whole for the whole tile when it is whole for every point of T (its box misses T
+// and area < epsilon · distance² from its centre to T), so each pixel's sum is its own cut or a
+// finer one, never coarser. A node that some pixel must open and that is small beside T (silhouette
+// tiles span depth) becomes a frontier entry: each pixel walks it on its own, as without tiles.
+// Points (leaves) reached are evaluated singly. The walk runs twice: once to count, then, after
+// one atomic allocation in the list buffer, to write; a tile whose list does not fit is marked
+// for a walk from the root per pixel (the host then grows the buffer for the next try).
+#include "points.glsl"
+#include "subsurface_params.glsl"
+#include "tile_lists.glsl"
+// One SIMD group of llvmpipe per work group; a row of tiles per dispatch row.
+layout(local_size_x = 8) in;
+
+layout(std140, binding = 0) uniform Params { SubsurfaceParams params; };
+layout(binding = 1) uniform usamplerBuffer nodes;
+layout(binding = 2) uniform usamplerBuffer points;
+layout(binding = 3, rgba32f) uniform readonly image2D surface_position;
+layout(std430, binding = 4) writeonly buffer Headers { uvec4 headers[]; };
+layout(std430, binding = 5) writeonly buffer Entries { uint entries[]; };
+layout(std430, binding = 6) buffer Allocation { uint allocated; } allocation;
+layout(push_constant) uniform TileCutConstants {
+    uvec2 tiles;      // tiles across and down
+    uvec2 pixels;     // image width and height
+    uint capacity;    // entries the list buffer holds
+    uint light_count;
+} pc;
+
+const uint STACK_SIZE = 96u;
+
+// The squared distance from p to the box [lo, hi] (0 inside).
+float distance2_to_box(vec3 p, vec3 lo, vec3 hi) {
+    vec3 d = max(max(lo - p, p - hi), vec3(0.0));
+    return dot(d, d);
+}
+
+// Counts (write = false) or writes (write = true, at `first`) the tile's list; returns the counts
+// of points, nodes and frontier entries.
+uvec3 walk(vec3 tile_lo, vec3 tile_hi, bool write, uint first, uvec3 counts) {
+    float tile_extent2 = dot(tile_hi - tile_lo, tile_hi - tile_lo);
+    uvec3 n = uvec3(0u);
+    uint stack[STACK_SIZE];
+    uint top = 0u;
+    stack[top++] = 0u;
+    uint steps = 0u;
+    while (top > 0u) {
+        uint item = stack[--top];
+        ++steps;
+        uint index = item & ~LEAF_BIT;
+        if ((item & LEAF_BIT) != 0u) {
+            if (texel_float(points, index * POINT_TEXELS + 2u).xyz == vec3(0.0)) continue;
+            if (write) entries[first + n.x] = index;
+            ++n.x;
+            continue;
+        }
+        vec4 power_area = texel_float(nodes, index * NODE_TEXELS);
+        if (power_area.xyz == vec3(0.0)) continue;
+        uvec4 center_left = texel(nodes, index * NODE_TEXELS + 1u);
+        uvec4 box_right = texel(nodes, index * NODE_TEXELS + 2u);
+        vec3 lo, hi;
+        unpack_box(box_right.xyz, lo, hi);
+        bool overlaps = all(lessThanEqual(lo, tile_hi)) && all(lessThanEqual(tile_lo, hi));
+        float d2 = distance2_to_box(uintBitsToFloat(center_left.xyz), tile_lo, tile_hi);
+        bool whole = !overlaps && power_area.w < params.epsilon * d2;
+        // Budgets: the stack, and the list's evaluations against llvmpipe's loop budget (the
+        // shade pass loops over them); past them a node is used whole, as the pixel walk does.
+        uint evaluations = (n.x + 2u * n.y) * pc.light_count;
+        bool must_stop = top + 2u > STACK_SIZE || steps > MAX_CUT_STEPS || evaluations > MAX_LIST_EVALUATIONS;
+        if (whole || must_stop) {
+            if (write) entries[first + counts.x + n.y] = index;
+            ++n.y;
+        } else if (dot(hi - lo, hi - lo) * 4.0 < tile_extent2) {
+            // Small beside the tile: pixels differ on how to cut it, so each walks it.
+            if (write) entries[first + counts.x + counts.y + n.z] = index;
+            ++n.z;
+        } else {
+            stack[top++] = center_left.w;
+            stack[top++] = box_right.w;
+        }
+    }
+    return n;
+}
+
+void main() {
+    uvec2 tile_xy = gl_GlobalInvocationID.xy;
+    if (tile_xy.x >= pc.tiles.x || tile_xy.y >= pc.tiles.y) return;
+    uint tile = tile_xy.y * pc.tiles.x + tile_xy.x;
+    ivec2 origin = ivec2(tile_xy) * int(TILE_SIZE);
+    vec3 lo = vec3(3.4e38), hi = vec3(-3.4e38);
+    bool covered = false;
+    for (int y = 0; y < int(TILE_SIZE); ++y) {
+        for (int x = 0; x < int(TILE_SIZE); ++x) {
+            ivec2 p = origin + ivec2(x, y);
+            if (p.x >= int(pc.pixels.x) || p.y >= int(pc.pixels.y)) continue;
+            vec4 s = imageLoad(surface_position, p);
+            if (s.w == 0.0) continue;
+            lo = min(lo, s.xyz);
+            hi = max(hi, s.xyz);
+            covered = true;
+        }
+    }
+    if (!covered || params.node_count == 0u) {
+        headers[tile] = uvec4(0u);
+        return;
+    }
+    uvec3 counts = walk(lo, hi, false, 0u, uvec3(0u));
+    uint total = counts.x + counts.y + counts.z;
+    uint first = atomicAdd(allocation.allocated, total);
+    if (first + total > pc.capacity || first + total < first) {
+        headers[tile] = uvec4(0u, 0u, 0u, WALK_FROM_ROOT);
+        return;
+    }
+    walk(lo, hi, true, first, counts);
+    headers[tile] = uvec4(first, counts);
+}

@@ -1,0 +1,143 @@
+//! The tile-cut pass (shaders/tile_cut.comp): per screen tile of `TILE_SIZE`² pixels, the list of
+//! tree nodes and points that are far and small enough for every pixel of the tile, so that the
+//! shade pass's lanes for a tile evaluate the same sources in step. Reads: subsurface parameters,
+//! tree nodes, sorted points, the G-buffer's positions. Writes: tile headers, list entries, the
+//! allocation counter.
+
+use bytemuck::{Pod, Zeroable};
+
+use crate::error::Result;
+use crate::vk::{Bind, BindingKind, Buffer, BufferUsageFlags, Context, Image, MemoryLocation, Pipeline, Recorder};
+
+/// Pixels per tile side. Mirrors `TILE_SIZE` in shaders/include/tile_lists.glsl.
+pub const TILE_SIZE: u32 = 8;
+/// A header's frontier count meaning "every pixel walks from the root". Mirrors `WALK_FROM_ROOT`.
+pub const WALK_FROM_ROOT: u32 = u32::MAX;
+/// List entries allotted per tile before a frame has told how many it needs.
+const INITIAL_ENTRIES_PER_TILE: u64 = 256;
+
+/// Mirrors the push constants of shaders/tile_cut.comp.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct TileCutConstants {
+    pub tiles: [u32; 2],
+    pub pixels: [u32; 2],
+    pub capacity: u32,
+    pub light_count: u32,
+}
+
+/// The lists of one frame size: a header per tile, the entries, and the allocation counter the
+/// host reads to learn whether every list fitted.
+pub struct TileLists {
+    pub headers: Buffer,
+    pub entries: Buffer,
+    allocation: Buffer,
+    /// Entries the buffer holds.
+    pub capacity: u64,
+    pub tiles: [u32; 2],
+    pixels: [u32; 2],
+}
+
+impl TileLists {
+    pub fn new(ctx: &Context, width: u32, height: u32, capacity: Option<u64>) -> Result<TileLists> {
+        let tiles = [width.div_ceil(TILE_SIZE), height.div_ceil(TILE_SIZE)];
+        let tile_count = tiles[0] as u64 * tiles[1] as u64;
+        let capacity = capacity.unwrap_or(tile_count * INITIAL_ENTRIES_PER_TILE).clamp(4, max_entries(ctx));
+        // TRANSFER_DST: frames without a cut clear the headers.
+        let usage =
+            BufferUsageFlags::STORAGE_BUFFER | BufferUsageFlags::UNIFORM_TEXEL_BUFFER | BufferUsageFlags::TRANSFER_DST;
+        Ok(TileLists {
+            headers: Buffer::new(ctx, "tile list headers", tile_count * 16, usage, MemoryLocation::GpuOnly)?,
+            // Whole texels of 4 entries.
+            entries: Buffer::new(
+                ctx,
+                "tile list entries",
+                capacity.next_multiple_of(4) * 4,
+                usage,
+                MemoryLocation::GpuOnly,
+            )?,
+            allocation: Buffer::new(
+                ctx,
+                "tile list allocation",
+                4,
+                BufferUsageFlags::STORAGE_BUFFER | BufferUsageFlags::TRANSFER_DST,
+                MemoryLocation::GpuToCpu,
+            )?,
+            capacity,
+            tiles,
+            pixels: [width, height],
+        })
+    }
+
+    /// Entries the last cut asked for (all tiles, whether they fitted or not).
+    pub fn entries_needed(&self) -> Result<u64> {
+        Ok(self.allocation.read::<u32>(1)?[0] as u64)
+    }
+
+    /// Whether every tile's list fitted, and if not, lists big enough for the last cut's needs
+    /// (a quarter more, within the device's limits), or `None` when they are as big as allowed.
+    pub fn grown(&self, ctx: &Context) -> Result<Option<TileLists>> {
+        let needed = self.entries_needed()?;
+        let max = max_entries(ctx);
+        if needed <= self.capacity || self.capacity >= max {
+            return Ok(None);
+        }
+        let capacity = (needed + needed / 4).min(max);
+        Ok(Some(TileLists::new(ctx, self.pixels[0], self.pixels[1], Some(capacity))?))
+    }
+}
+
+/// The most list entries: one storage buffer, and its texel view (4 entries per texel).
+fn max_entries(ctx: &Context) -> u64 {
+    let limits = ctx.limits();
+    (limits.max_storage_buffer_range as u64 / 4).min(limits.max_texel_buffer_elements as u64 * 4)
+}
+
+pub struct TileCutPass {
+    pipeline: Pipeline,
+}
+
+impl TileCutPass {
+    pub fn new(ctx: &Context) -> Result<TileCutPass> {
+        use BindingKind::*;
+        let bindings =
+            [UniformBuffer, TexelBuffer, TexelBuffer, StorageImage, StorageBuffer, StorageBuffer, StorageBuffer];
+        let size = std::mem::size_of::<TileCutConstants>() as u32;
+        Ok(TileCutPass { pipeline: Pipeline::compute(ctx, "tile_cut.comp", &bindings, size)? })
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &self,
+        rec: &mut Recorder,
+        params: &Buffer,
+        nodes: &Buffer,
+        points: &Buffer,
+        position: &Image,
+        lists: &TileLists,
+        light_count: u32,
+    ) -> Result<()> {
+        rec.fill_buffer(&lists.allocation, 0)?;
+        let constants = TileCutConstants {
+            tiles: lists.tiles,
+            pixels: lists.pixels,
+            capacity: lists.capacity.min(u32::MAX as u64) as u32,
+            light_count,
+        };
+        rec.dispatch(
+            &self.pipeline,
+            &[
+                Bind::Uniform(params),
+                Bind::Texels(nodes),
+                Bind::Texels(points),
+                Bind::StorageImageRead(position),
+                Bind::Write(&lists.headers),
+                Bind::Write(&lists.entries),
+                Bind::Write(&lists.allocation),
+            ],
+            bytemuck::bytes_of(&constants),
+            [lists.tiles[0].div_ceil(8), lists.tiles[1], 1],
+        )?;
+        rec.host_read(&lists.allocation)
+    }
+}
