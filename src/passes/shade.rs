@@ -8,8 +8,8 @@ use glam::{Mat4, Vec4};
 
 use crate::error::Result;
 use crate::vk::{
-    self, Bind, BindingKind, Buffer, Context, CullModeFlags, Format, GraphicsDesc, Image, Pipeline, PrimitiveTopology,
-    Recorder, Sampler,
+    self, Bind, Buffer, Context, CullModeFlags, Format, GraphicsDesc, Image, Pipeline, PrimitiveTopology, Recorder,
+    Sampler,
 };
 
 pub const COLOR_FORMAT: Format = Format::R32G32B32A32_SFLOAT;
@@ -124,7 +124,6 @@ const VERTEX_STRIDE: u32 = 24;
 
 impl ShadePass {
     pub fn new(ctx: &Context) -> Result<ShadePass> {
-        use BindingKind::*;
         let shading = |additive_blend: bool| {
             Pipeline::graphics(
                 ctx,
@@ -141,17 +140,6 @@ impl ShadePass {
                     depth_bias: false,
                     cull_mode: CullModeFlags::NONE,
                     additive_blend,
-                    bindings: &[
-                        StorageBuffer,
-                        StorageBuffer,
-                        StorageBuffer,
-                        StorageBuffer,
-                        StorageBuffer,
-                        SampledImage,
-                        StorageBuffer,
-                        StorageBuffer,
-                    ],
-                    push_constant_size: std::mem::size_of::<ShadeConstants>() as u32,
                 },
             )
         };
@@ -172,8 +160,6 @@ impl ShadePass {
                 depth_bias: false,
                 cull_mode: CullModeFlags::NONE,
                 additive_blend: false,
-                bindings: &[],
-                push_constant_size: 64,
             },
         )?;
         Ok(ShadePass { depth_prepass, pipeline, additive })

@@ -66,8 +66,6 @@ impl ShadowPass {
                 depth_bias: true,
                 cull_mode: CullModeFlags::NONE,
                 additive_blend: false,
-                bindings: &[],
-                push_constant_size: 64,
             },
         )?;
         Ok(ShadowPass { pipeline })

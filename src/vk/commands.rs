@@ -9,11 +9,12 @@ use std::cell::RefCell;
 use ash::vk;
 
 use super::context::Context;
-use super::pipeline::{BindingKind, Pipeline};
+use super::pipeline::{descriptor_type, Pipeline};
 use super::profiler::GpuProfiler;
 use super::resources::{aspect_of, has_stencil, Access, Buffer, Image, Sampler, Transition};
 use crate::error::Result;
 use crate::runtime;
+use crate::shaders::DescriptorKind;
 
 /// Per-context objects for recording: one command buffer, its fence and a descriptor pool that is
 /// reset after every submission (one submission in flight at a time).
@@ -111,6 +112,66 @@ pub enum Bind<'a> {
     Sampled(&'a Image, &'a Sampler),
     StorageImageRead(&'a Image),
     StorageImageWrite(&'a Image),
+}
+
+impl Bind<'_> {
+    fn describe(&self) -> &'static str {
+        match self {
+            Bind::Read(_) => "Bind::Read",
+            Bind::Write(_) => "Bind::Write",
+            Bind::Uniform(_) => "Bind::Uniform",
+            Bind::Sampled(..) => "Bind::Sampled",
+            Bind::StorageImageRead(_) => "Bind::StorageImageRead",
+            Bind::StorageImageWrite(_) => "Bind::StorageImageWrite",
+        }
+    }
+}
+
+impl Pipeline {
+    /// Checks a use's resources against the shaders' bindings: one per binding, in binding order,
+    /// of the declared kind; a read-only use only where the shader cannot write, a writing one only
+    /// where it is not `readonly`.
+    pub(crate) fn check_binds(&self, binds: &[Bind]) -> Result<()> {
+        if binds.len() != self.bindings.len() {
+            return Err(runtime!(
+                "pipeline {}: {} resources bound, its shaders declare {} bindings",
+                self.name,
+                binds.len(),
+                self.bindings.len()
+            ));
+        }
+        for (i, (bind, binding)) in binds.iter().zip(&self.bindings).enumerate() {
+            let at = || format!("pipeline {}: binding {i}, {}", self.name, binding.declared_in);
+            let kind_ok = matches!(
+                (bind, binding.kind),
+                (Bind::Read(_) | Bind::Write(_), DescriptorKind::StorageBuffer)
+                    | (Bind::Uniform(_), DescriptorKind::UniformBuffer)
+                    | (Bind::Sampled(..), DescriptorKind::CombinedImageSampler)
+                    | (Bind::StorageImageRead(_) | Bind::StorageImageWrite(_), DescriptorKind::StorageImage)
+            );
+            if !kind_ok {
+                return Err(runtime!("{}: {} given for a {:?}", at(), bind.describe(), binding.kind));
+            }
+            match bind {
+                Bind::Read(_) | Bind::StorageImageRead(_) if !binding.read_only => {
+                    return Err(runtime!(
+                        "{}: {} of a resource the shader may write (not `readonly`): use the writing Bind",
+                        at(),
+                        bind.describe()
+                    ))
+                }
+                Bind::Write(_) | Bind::StorageImageWrite(_) if binding.read_only => {
+                    return Err(runtime!(
+                        "{}: {} of a resource the shader declares `readonly`: use the reading Bind",
+                        at(),
+                        bind.describe()
+                    ))
+                }
+                _ => {}
+            }
+        }
+        Ok(())
+    }
 }
 
 /// Records commands into the context's command buffer.
@@ -323,36 +384,16 @@ impl<'a> Recorder<'a> {
 
     /// Allocates and writes set 0 for `pipeline`, transitioning each bound resource for `stage`.
     fn bind(&mut self, pipeline: &Pipeline, binds: &[Bind], push_constants: &[u8], stage: Stage) -> Result<()> {
-        if binds.len() != pipeline.bindings.len() {
-            return Err(runtime!(
-                "pipeline {}: {} resources bound, {} declared",
-                pipeline.name,
-                binds.len(),
-                pipeline.bindings.len()
-            ));
-        }
+        pipeline.check_binds(binds)?;
         if push_constants.len() as u32 != pipeline.push_constant_size {
             return Err(runtime!(
-                "pipeline {}: {} bytes of push constants, {} declared",
+                "pipeline {}: {} bytes of push constants, its shaders declare {}",
                 pipeline.name,
                 push_constants.len(),
                 pipeline.push_constant_size
             ));
         }
-        for (i, (bind, kind)) in binds.iter().zip(&pipeline.bindings).enumerate() {
-            let ok = matches!(
-                (bind, kind),
-                (Bind::Read(_) | Bind::Write(_), BindingKind::StorageBuffer)
-                    | (Bind::Uniform(_), BindingKind::UniformBuffer)
-                    | (Bind::Sampled(..), BindingKind::SampledImage)
-                    | (Bind::StorageImageRead(_) | Bind::StorageImageWrite(_), BindingKind::StorageImage)
-            );
-            if !ok {
-                return Err(runtime!(
-                    "pipeline {}: binding {i} does not match its declared kind {kind:?}",
-                    pipeline.name
-                ));
-            }
+        for bind in binds {
             self.declare(bind, stage)?;
         }
         let device = self.ctx.device();
@@ -399,7 +440,7 @@ impl<'a> Recorder<'a> {
                     let w = vk::WriteDescriptorSet::default()
                         .dst_set(set)
                         .dst_binding(i as u32)
-                        .descriptor_type(pipeline.bindings[i].descriptor_type());
+                        .descriptor_type(descriptor_type(pipeline.bindings[i].kind));
                     match b {
                         Bind::Read(_) | Bind::Write(_) | Bind::Uniform(_) => w.buffer_info(&buffer_infos[i]),
                         _ => w.image_info(&image_infos[i]),
@@ -414,7 +455,7 @@ impl<'a> Recorder<'a> {
         unsafe {
             device.cmd_bind_pipeline(self.cmd, pipeline.bind_point, pipeline.raw);
             if !push_constants.is_empty() {
-                device.cmd_push_constants(self.cmd, pipeline.layout, pipeline.stages, 0, push_constants);
+                device.cmd_push_constants(self.cmd, pipeline.layout, pipeline.push_stages, 0, push_constants);
             }
         }
         Ok(())

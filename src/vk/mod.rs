@@ -4,6 +4,7 @@
 
 mod commands;
 mod context;
+mod guard;
 mod overlay;
 mod pipeline;
 mod profiler;
@@ -14,7 +15,7 @@ pub use ash::vk::{BufferUsageFlags, CullModeFlags, Extent2D, Format, ImageUsageF
 pub use commands::{Bind, Recorder};
 pub use context::{list_devices, Context, ContextOptions, DeviceInfo, ValidationCounts};
 pub use overlay::{Overlay, OverlayFrame};
-pub use pipeline::{check_all_shaders, BindingKind, GraphicsDesc, Pipeline};
+pub use pipeline::{check_all_shaders, GraphicsDesc, Pipeline};
 pub use profiler::{GpuProfiler, TimedScope};
 pub use resources::{Access, Buffer, Image, MemoryLocation, Sampler};
 pub use swapchain::{PresentMode, Presented, Presenter, FRAMES_IN_FLIGHT};
