@@ -118,7 +118,7 @@ pub struct Context {
     pub has_shader_int64: bool,
     counts: Arc<ValidationCounts>,
     pub validation: bool,
-    pub(crate) commands: super::commands::CommandsCell,
+    pub(crate) commands: super::submit::CommandsCell,
 }
 
 impl Drop for Context {
@@ -521,7 +521,7 @@ impl Context {
             Err(e) => return Err(fail(&debug, runtime!("vkCreateDevice on {}: {e}", info.name))),
         };
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
-        let commands = match super::commands::Commands::new(&device, queue_family) {
+        let commands = match super::submit::Commands::new(&device, queue_family) {
             Ok(c) => c,
             Err(e) => {
                 unsafe { device.destroy_device(None) };
