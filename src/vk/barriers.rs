@@ -397,3 +397,40 @@ impl Recorder<'_> {
         self.pending.images.clear();
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn buffer_barriers_follow_writes_and_reads() {
+        let mut s = TrackedState::new();
+        assert_eq!(s.buffer_transition(BufferAccess::TRANSFER_WRITE), None, "first use waits for nothing");
+        let raw = s.buffer_transition(BufferAccess::COMPUTE_READ).expect("read after write");
+        assert_eq!(
+            (raw.src_stage, raw.src_access),
+            (vk::PipelineStageFlags2::TRANSFER, vk::AccessFlags2::TRANSFER_WRITE)
+        );
+        assert_eq!(
+            (raw.dst_stage, raw.dst_access),
+            (BufferAccess::COMPUTE_READ.stage, BufferAccess::COMPUTE_READ.access)
+        );
+        assert_eq!((raw.old_layout, raw.new_layout), (vk::ImageLayout::UNDEFINED, vk::ImageLayout::UNDEFINED));
+        assert_eq!(s.buffer_transition(BufferAccess::COMPUTE_READ), None, "the write is already visible");
+        let war = s.buffer_transition(BufferAccess::COMPUTE_WRITE).expect("write after read");
+        assert_eq!(war.src_stage, vk::PipelineStageFlags2::TRANSFER | vk::PipelineStageFlags2::COMPUTE_SHADER);
+        assert_eq!(s.layout, vk::ImageLayout::UNDEFINED, "buffers have no layout");
+    }
+
+    #[test]
+    fn image_layout_changes_need_a_barrier_even_for_reads() {
+        let mut s = TrackedState::new();
+        let first = s.image_transition(Access::COMPUTE_SAMPLED).expect("layout change");
+        assert_eq!((first.old_layout, first.new_layout), (vk::ImageLayout::UNDEFINED, Access::COMPUTE_SAMPLED.layout));
+        assert_eq!(first.src_stage, vk::PipelineStageFlags2::NONE);
+        assert_eq!(s.image_transition(Access::COMPUTE_SAMPLED), None);
+        let to_write = s.image_transition(Access::TRANSFER_WRITE).expect("layout change");
+        assert_eq!(to_write.old_layout, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
+        assert_eq!(to_write.src_stage, vk::PipelineStageFlags2::COMPUTE_SHADER);
+    }
+}

@@ -14,6 +14,7 @@ pub(crate) const SETS_PER_SUBMIT: u32 = 512;
 
 /// A resource bound to a pipeline, with how the shader uses it. A dispatch or draw lists one per
 /// binding of its shaders, in binding order.
+#[derive(Clone, Copy)]
 pub enum Bind<'a> {
     /// Storage buffer the shader only reads (`readonly` in GLSL).
     Read(&'a Buffer),
