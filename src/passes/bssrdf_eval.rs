@@ -6,7 +6,7 @@ use glam::Vec4;
 
 use crate::error::Result;
 use crate::physics::{Diffusion, GpuChannel, Model, Query};
-use crate::vk::{Bind, BindingKind, Buffer, BufferUsageFlags, Context, MemoryLocation, Pipeline};
+use crate::vk::{Bind, Buffer, BufferUsageFlags, Context, MemoryLocation, Pipeline};
 
 /// Mirrors `BssrdfQuery` in shaders/bssrdf_eval.comp (std430: 64 + 5 × 16 bytes).
 #[repr(C)]
@@ -35,12 +35,7 @@ pub struct BssrdfEvalPass {
 
 impl BssrdfEvalPass {
     pub fn new(ctx: &Context) -> Result<BssrdfEvalPass> {
-        let pipeline = Pipeline::compute(
-            ctx,
-            "bssrdf_eval.comp",
-            &[BindingKind::StorageBuffer, BindingKind::StorageBuffer],
-            std::mem::size_of::<EvalConstants>() as u32,
-        )?;
+        let pipeline = Pipeline::compute(ctx, "bssrdf_eval.comp")?;
         Ok(BssrdfEvalPass { pipeline })
     }
 

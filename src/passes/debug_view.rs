@@ -8,8 +8,7 @@ use glam::{Mat4, Vec3, Vec4};
 use crate::error::Result;
 use crate::hierarchy::{TreeNode, LEAF_BIT};
 use crate::vk::{
-    self, Bind, BindingKind, Buffer, Context, CullModeFlags, Format, GraphicsDesc, Image, Pipeline, PrimitiveTopology,
-    Recorder,
+    self, Bind, Buffer, Context, CullModeFlags, Format, GraphicsDesc, Image, Pipeline, PrimitiveTopology, Recorder,
 };
 
 use super::shade::{COLOR_FORMAT, DEPTH_FORMAT};
@@ -29,34 +28,23 @@ pub struct DebugViewPass {
 
 impl DebugViewPass {
     pub fn new(ctx: &Context) -> Result<DebugViewPass> {
-        let desc = |vertex_shader,
-                    topology,
-                    stride,
-                    attributes: &'static [(u32, Format, u32)],
-                    bindings: &'static [BindingKind]| {
-            GraphicsDesc {
-                vertex_shader,
-                fragment_shader: Some("debug/color.frag"),
-                vertex_stride: stride,
-                vertex_attributes: attributes,
-                topology,
-                color_formats: &[COLOR_FORMAT],
-                depth_format: Some(DEPTH_FORMAT),
-                depth_test: true,
-                depth_equal: false,
-                depth_bias: false,
-                cull_mode: CullModeFlags::NONE,
-                additive_blend: false,
-                specialization: &[],
-                bindings,
-                push_constant_size: std::mem::size_of::<DebugConstants>() as u32,
-            }
+        let desc = |vertex_shader, topology, stride, attributes: &'static [(u32, Format, u32)]| GraphicsDesc {
+            vertex_shader,
+            fragment_shader: Some("debug/color.frag"),
+            vertex_stride: stride,
+            vertex_attributes: attributes,
+            topology,
+            color_formats: &[COLOR_FORMAT],
+            depth_format: Some(DEPTH_FORMAT),
+            depth_test: true,
+            depth_equal: false,
+            depth_bias: false,
+            cull_mode: CullModeFlags::NONE,
+            additive_blend: false,
+            specialization: &[],
         };
         Ok(DebugViewPass {
-            points: Pipeline::graphics(
-                ctx,
-                &desc("debug/points.vert", PrimitiveTopology::POINT_LIST, 0, &[], &[BindingKind::StorageBuffer]),
-            )?,
+            points: Pipeline::graphics(ctx, &desc("debug/points.vert", PrimitiveTopology::POINT_LIST, 0, &[]))?,
             lines: Pipeline::graphics(
                 ctx,
                 &desc(
@@ -64,7 +52,6 @@ impl DebugViewPass {
                     PrimitiveTopology::LINE_LIST,
                     24,
                     &[(0, Format::R32G32B32_SFLOAT, 0), (1, Format::R32G32B32_SFLOAT, 12)],
-                    &[],
                 ),
             )?,
         })

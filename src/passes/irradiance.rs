@@ -6,7 +6,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::Vec4;
 
 use crate::error::Result;
-use crate::vk::{Bind, BindingKind, Buffer, Context, Image, Pipeline, Recorder, Sampler};
+use crate::vk::{Bind, Buffer, Context, Image, Pipeline, Recorder, Sampler};
 
 pub const MAX_LIGHTS: usize = 8;
 
@@ -37,15 +37,7 @@ pub struct IrradiancePass {
 
 impl IrradiancePass {
     pub fn new(ctx: &Context) -> Result<IrradiancePass> {
-        use BindingKind::*;
-        Ok(IrradiancePass {
-            pipeline: Pipeline::compute(
-                ctx,
-                "hierarchy/irradiance.comp",
-                &[StorageBuffer, StorageBuffer, SampledImage, StorageBuffer],
-                4,
-            )?,
-        })
+        Ok(IrradiancePass { pipeline: Pipeline::compute(ctx, "hierarchy/irradiance.comp")? })
     }
 
     #[allow(clippy::too_many_arguments)]

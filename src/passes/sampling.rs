@@ -4,7 +4,7 @@
 use bytemuck::{Pod, Zeroable};
 
 use crate::error::Result;
-use crate::vk::{Bind, BindingKind, Buffer, Context, Pipeline, Recorder};
+use crate::vk::{Bind, Buffer, Context, Pipeline, Recorder};
 
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
@@ -21,10 +21,9 @@ pub struct SamplingPass {
 
 impl SamplingPass {
     pub fn new(ctx: &Context) -> Result<SamplingPass> {
-        use BindingKind::StorageBuffer as S;
         Ok(SamplingPass {
-            areas: Pipeline::compute(ctx, "hierarchy/triangle_areas.comp", &[S, S, S], 8)?,
-            points: Pipeline::compute(ctx, "hierarchy/sample_points.comp", &[S, S, S, S], 12)?,
+            areas: Pipeline::compute(ctx, "hierarchy/triangle_areas.comp")?,
+            points: Pipeline::compute(ctx, "hierarchy/sample_points.comp")?,
         })
     }
 

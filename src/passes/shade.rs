@@ -11,8 +11,8 @@ use glam::{Mat4, Vec4};
 
 use crate::error::Result;
 use crate::vk::{
-    self, Bind, BindingKind, Buffer, Context, CullModeFlags, Format, GraphicsDesc, Image, Pipeline, PrimitiveTopology,
-    Recorder, Sampler,
+    self, Bind, Buffer, Context, CullModeFlags, Format, GraphicsDesc, Image, Pipeline, PrimitiveTopology, Recorder,
+    Sampler,
 };
 
 pub const COLOR_FORMAT: Format = Format::R32G32B32A32_SFLOAT;
@@ -136,11 +136,10 @@ pub struct ShadePass {
 const VERTEX_STRIDE: u32 = 24;
 
 fn shading_pipeline(ctx: &Context, model: u32, additive_blend: bool) -> Result<Pipeline> {
-    use BindingKind::*;
     Pipeline::graphics(
         ctx,
         &GraphicsDesc {
-            vertex_shader: "fullscreen.vert",
+            vertex_shader: "shade.vert",
             fragment_shader: Some("shade.frag"),
             vertex_stride: 0,
             vertex_attributes: &[],
@@ -153,22 +152,6 @@ fn shading_pipeline(ctx: &Context, model: u32, additive_blend: bool) -> Result<P
             cull_mode: CullModeFlags::NONE,
             additive_blend,
             specialization: &[model],
-            bindings: &[
-                UniformBuffer,
-                TexelBuffer,
-                TexelBuffer,
-                StorageBuffer,
-                StorageBuffer,
-                SampledImage,
-                TexelBuffer,
-                TexelBuffer,
-                StorageImage,
-                StorageImage,
-                TexelBuffer,
-                TexelBuffer,
-                TexelBuffer,
-            ],
-            push_constant_size: std::mem::size_of::<ShadeConstants>() as u32,
         },
     )
 }
@@ -191,8 +174,6 @@ impl ShadePass {
                 cull_mode: CullModeFlags::NONE,
                 additive_blend: false,
                 specialization: &[],
-                bindings: &[],
-                push_constant_size: std::mem::size_of::<ShadeConstants>() as u32,
             },
         )?;
         Ok(ShadePass { surface, shading: Default::default() })

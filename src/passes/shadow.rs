@@ -67,8 +67,6 @@ impl ShadowPass {
                 cull_mode: CullModeFlags::NONE,
                 additive_blend: false,
                 specialization: &[],
-                bindings: &[],
-                push_constant_size: 64,
             },
         )?;
         Ok(ShadowPass { pipeline })

@@ -6,7 +6,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::{Vec3, Vec4};
 
 use crate::error::Result;
-use crate::vk::{Bind, BindingKind, Buffer, Context, Pipeline, Recorder};
+use crate::vk::{Bind, Buffer, Context, Pipeline, Recorder};
 
 /// Keys per tile of the radix sort (radix.glsl).
 pub const TILE: u32 = 256;
@@ -49,13 +49,12 @@ pub struct SortPass {
 
 impl SortPass {
     pub fn new(ctx: &Context) -> Result<SortPass> {
-        use BindingKind::StorageBuffer as S;
         Ok(SortPass {
-            morton: Pipeline::compute(ctx, "hierarchy/morton.comp", &[S, S, S], 48)?,
-            histogram: Pipeline::compute(ctx, "hierarchy/radix_histogram.comp", &[S, S], 12)?,
-            scan: Pipeline::compute(ctx, "hierarchy/radix_scan.comp", &[S], 12)?,
-            scatter: Pipeline::compute(ctx, "hierarchy/radix_scatter.comp", &[S, S, S, S, S], 12)?,
-            gather: Pipeline::compute(ctx, "hierarchy/gather_points.comp", &[S, S, S, S, S], 8)?,
+            morton: Pipeline::compute(ctx, "hierarchy/morton.comp")?,
+            histogram: Pipeline::compute(ctx, "hierarchy/radix_histogram.comp")?,
+            scan: Pipeline::compute(ctx, "hierarchy/radix_scan.comp")?,
+            scatter: Pipeline::compute(ctx, "hierarchy/radix_scatter.comp")?,
+            gather: Pipeline::compute(ctx, "hierarchy/gather_points.comp")?,
         })
     }
 

@@ -7,7 +7,7 @@
 use bytemuck::{Pod, Zeroable};
 
 use crate::error::Result;
-use crate::vk::{Bind, BindingKind, Buffer, BufferUsageFlags, Context, Image, MemoryLocation, Pipeline, Recorder};
+use crate::vk::{Bind, Buffer, BufferUsageFlags, Context, Image, MemoryLocation, Pipeline, Recorder};
 
 /// Pixels per tile side. Mirrors `TILE_SIZE` in shaders/include/tile_lists.glsl.
 pub const TILE_SIZE: u32 = 8;
@@ -99,11 +99,7 @@ pub struct TileCutPass {
 
 impl TileCutPass {
     pub fn new(ctx: &Context) -> Result<TileCutPass> {
-        use BindingKind::*;
-        let bindings =
-            [UniformBuffer, TexelBuffer, TexelBuffer, StorageImage, StorageBuffer, StorageBuffer, StorageBuffer];
-        let size = std::mem::size_of::<TileCutConstants>() as u32;
-        Ok(TileCutPass { pipeline: Pipeline::compute(ctx, "tile_cut.comp", &bindings, size)? })
+        Ok(TileCutPass { pipeline: Pipeline::compute(ctx, "tile_cut.comp")? })
     }
 
     #[allow(clippy::too_many_arguments)]

@@ -7,7 +7,7 @@ use bytemuck::{Pod, Zeroable};
 use crate::error::Result;
 use crate::output::{self, Exposure, HIST_BINS, HIST_BINS_PER_STOP, HIST_LOG2_MIN};
 use crate::runtime;
-use crate::vk::{self, Bind, BindingKind, Buffer, BufferUsageFlags, Context, Format, Image, Pipeline, Recorder};
+use crate::vk::{self, Bind, Buffer, BufferUsageFlags, Context, Format, Image, Pipeline, Recorder};
 
 /// Mirrors `HistogramTables` in shaders/tonemap.comp: the histogram definition of `output`, so the
 /// shader has no constants of its own.
@@ -70,13 +70,7 @@ pub struct TonemapPass {
 
 impl TonemapPass {
     pub fn new(ctx: &Context) -> Result<TonemapPass> {
-        use BindingKind::*;
-        let pipeline = Pipeline::compute(
-            ctx,
-            "tonemap.comp",
-            &[StorageImage, StorageBuffer, StorageBuffer, StorageBuffer],
-            std::mem::size_of::<TonemapConstants>() as u32,
-        )?;
+        let pipeline = Pipeline::compute(ctx, "tonemap.comp")?;
         let tables =
             vk::upload_buffer(ctx, "tonemap tables", &[HistogramTables::new()], BufferUsageFlags::STORAGE_BUFFER)?;
         Ok(TonemapPass { pipeline, tables })
@@ -124,7 +118,8 @@ impl TonemapPass {
                             Bind::StorageImageRead(hdr),
                             Bind::Read(&self.tables),
                             Bind::Write(histogram),
-                            Bind::Read(ldr),
+                            // The shader declares it writable (stage 2 writes it).
+                            Bind::Write(ldr),
                         ],
                         bytemuck::bytes_of(&constants),
                         groups,
@@ -135,7 +130,8 @@ impl TonemapPass {
         constants.stage = 2;
         rec.dispatch(
             &self.pipeline,
-            &[Bind::StorageImageRead(hdr), Bind::Read(&self.tables), Bind::Read(histogram), Bind::Write(ldr)],
+            // The histogram is declared writable (stages 0 and 1 write it).
+            &[Bind::StorageImageRead(hdr), Bind::Read(&self.tables), Bind::Write(histogram), Bind::Write(ldr)],
             bytemuck::bytes_of(&constants),
             groups,
         )

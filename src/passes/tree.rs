@@ -3,7 +3,7 @@
 //! records, parent links, arrival counters.
 
 use crate::error::Result;
-use crate::vk::{Bind, BindingKind, Buffer, Context, Pipeline, Recorder};
+use crate::vk::{Bind, Buffer, Context, Pipeline, Recorder};
 
 pub struct TreeBuffers<'a> {
     pub keys: &'a Buffer,
@@ -24,10 +24,9 @@ pub struct TreePass {
 
 impl TreePass {
     pub fn new(ctx: &Context) -> Result<TreePass> {
-        use BindingKind::StorageBuffer as S;
         Ok(TreePass {
-            build: Pipeline::compute(ctx, "hierarchy/tree_build.comp", &[S, S, S, S, S], 4)?,
-            aggregate: Pipeline::compute(ctx, "hierarchy/tree_aggregate.comp", &[S, S, S, S, S, S, S], 8)?,
+            build: Pipeline::compute(ctx, "hierarchy/tree_build.comp")?,
+            aggregate: Pipeline::compute(ctx, "hierarchy/tree_aggregate.comp")?,
         })
     }
 

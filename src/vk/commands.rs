@@ -1,252 +1,61 @@
-//! Recording and submitting command buffers.
-//!
-//! [`Context::submit`] records one command buffer through a [`Recorder`], submits it with a fence
-//! and waits. The recorder's methods are the only way passes touch a command buffer: each declares
-//! how it uses its resources, and the recorder inserts the synchronization2 barriers.
-
-use std::cell::RefCell;
+//! Recording commands: a [`Recorder`] is the only way passes touch a command buffer. Each
+//! method declares how its command uses its resources; the recorder inserts the barriers
+//! (`barriers.rs`), checks and writes the descriptors (`descriptors.rs`) and records the command.
+//! Submission is in `submit.rs`.
 
 use ash::vk;
 
+use super::barriers::{Access, BufferAccess, PendingBarriers};
 use super::context::Context;
-use super::pipeline::{BindingKind, Pipeline};
+use super::descriptors::{write_set, Bind};
+use super::pipeline::Pipeline;
 use super::profiler::GpuProfiler;
-use super::resources::{aspect_of, has_stencil, Access, Buffer, Image, Sampler, Transition};
+use super::resources::{aspect_of, has_stencil, Buffer, Image};
 use crate::error::Result;
 use crate::runtime;
-
-/// Per-context objects for recording: one command buffer, its fence and a descriptor pool that is
-/// reset after every submission (one submission in flight at a time).
-pub(crate) struct Commands {
-    pool: vk::CommandPool,
-    cmd: vk::CommandBuffer,
-    fence: vk::Fence,
-    descriptor_pool: vk::DescriptorPool,
-}
-
-const SETS_PER_SUBMIT: u32 = 512;
 
 /// Timestamps are written once all earlier commands are done. BOTTOM_OF_PIPE means that for a
 /// timestamp, as ALL_COMMANDS does, without the best-practices layer's warning about the latter.
 const TIMESTAMP_STAGE: vk::PipelineStageFlags2 = vk::PipelineStageFlags2::BOTTOM_OF_PIPE;
 
-/// A transient command pool and one primary command buffer from it, for `queue_family`.
-///
-/// # Safety
-/// `device` must be valid; the caller destroys the pool (which frees the buffer).
-pub(crate) unsafe fn command_pool_with_one_buffer(
-    device: &ash::Device,
-    queue_family: u32,
-) -> Result<(vk::CommandPool, vk::CommandBuffer)> {
-    let pool = device
-        .create_command_pool(
-            &vk::CommandPoolCreateInfo::default()
-                .queue_family_index(queue_family)
-                .flags(vk::CommandPoolCreateFlags::TRANSIENT),
-            None,
-        )
-        .map_err(|e| runtime!("vkCreateCommandPool: {e}"))?;
-    let cmd = device
-        .allocate_command_buffers(
-            &vk::CommandBufferAllocateInfo::default()
-                .command_pool(pool)
-                .level(vk::CommandBufferLevel::PRIMARY)
-                .command_buffer_count(1),
-        )
-        .map_err(|e| {
-            device.destroy_command_pool(pool, None);
-            runtime!("vkAllocateCommandBuffers: {e}")
-        })?[0];
-    Ok((pool, cmd))
-}
-
-impl Commands {
-    pub(crate) fn new(device: &ash::Device, queue_family: u32) -> Result<Commands> {
-        // SAFETY: valid device; each object is destroyed in `destroy`.
-        unsafe {
-            let (pool, cmd) = command_pool_with_one_buffer(device, queue_family)?;
-            let fence = device
-                .create_fence(&vk::FenceCreateInfo::default(), None)
-                .map_err(|e| runtime!("vkCreateFence: {e}"))?;
-            let sizes = [
-                vk::DescriptorPoolSize {
-                    ty: vk::DescriptorType::STORAGE_BUFFER,
-                    descriptor_count: SETS_PER_SUBMIT * 8,
-                },
-                vk::DescriptorPoolSize { ty: vk::DescriptorType::UNIFORM_BUFFER, descriptor_count: SETS_PER_SUBMIT },
-                vk::DescriptorPoolSize {
-                    ty: vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
-                    descriptor_count: SETS_PER_SUBMIT * 2,
-                },
-                vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_IMAGE, descriptor_count: SETS_PER_SUBMIT * 4 },
-                vk::DescriptorPoolSize {
-                    ty: vk::DescriptorType::UNIFORM_TEXEL_BUFFER,
-                    descriptor_count: SETS_PER_SUBMIT * 8,
-                },
-            ];
-            let descriptor_pool = device
-                .create_descriptor_pool(
-                    &vk::DescriptorPoolCreateInfo::default().max_sets(SETS_PER_SUBMIT).pool_sizes(&sizes),
-                    None,
-                )
-                .map_err(|e| runtime!("vkCreateDescriptorPool: {e}"))?;
-            Ok(Commands { pool, cmd, fence, descriptor_pool })
-        }
-    }
-
-    pub(crate) fn destroy(&mut self, device: &ash::Device) {
-        // SAFETY: called once, after the device is idle.
-        unsafe {
-            device.destroy_descriptor_pool(self.descriptor_pool, None);
-            device.destroy_fence(self.fence, None);
-            device.destroy_command_pool(self.pool, None);
-        }
-    }
-}
-
-/// A resource bound to a pipeline, with how the shader uses it.
-pub enum Bind<'a> {
-    /// Storage buffer the shader only reads.
-    Read(&'a Buffer),
-    /// Storage buffer the shader writes (and may read).
-    Write(&'a Buffer),
-    Uniform(&'a Buffer),
-    /// A buffer made with UNIFORM_TEXEL_BUFFER usage, read through its RGBA32UI texel view.
-    Texels(&'a Buffer),
-    /// Combined image sampler, read in `SHADER_READ_ONLY_OPTIMAL`.
-    Sampled(&'a Image, &'a Sampler),
-    StorageImageRead(&'a Image),
-    StorageImageWrite(&'a Image),
-}
-
-/// Records commands into the context's command buffer.
+/// Records commands into a command buffer of the context (see [`Context::submit`]).
 pub struct Recorder<'a> {
-    ctx: &'a Context,
-    cmd: vk::CommandBuffer,
+    pub(super) ctx: &'a Context,
+    pub(super) cmd: vk::CommandBuffer,
     descriptor_pool: vk::DescriptorPool,
     profiler: Option<&'a mut GpuProfiler>,
-    inside_rendering: bool,
+    pub(super) inside_rendering: bool,
     open_scopes: Vec<usize>,
-}
-
-impl Context {
-    /// Records commands with `record`, submits them and waits until the GPU has finished.
-    /// With a profiler, its timestamp scopes are resolved after the wait.
-    pub fn submit<T>(
-        &self,
-        profiler: Option<&mut GpuProfiler>,
-        record: impl FnOnce(&mut Recorder) -> Result<T>,
-    ) -> Result<T> {
-        let commands = self.commands.borrow();
-        let device = self.device();
-        // SAFETY: the previous submission was waited for, so the buffer and pool are free to reuse.
-        unsafe {
-            device
-                .reset_descriptor_pool(commands.descriptor_pool, vk::DescriptorPoolResetFlags::empty())
-                .map_err(|e| runtime!("vkResetDescriptorPool: {e}"))?;
-            device
-                .reset_command_pool(commands.pool, vk::CommandPoolResetFlags::empty())
-                .map_err(|e| runtime!("vkResetCommandPool: {e}"))?;
-            device
-                .begin_command_buffer(
-                    commands.cmd,
-                    &vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
-                )
-                .map_err(|e| runtime!("vkBeginCommandBuffer: {e}"))?;
-        }
-        let mut rec = Recorder {
-            ctx: self,
-            cmd: commands.cmd,
-            descriptor_pool: commands.descriptor_pool,
-            profiler,
-            inside_rendering: false,
-            open_scopes: Vec::new(),
-        };
-        let result = record(&mut rec);
-        if rec.inside_rendering {
-            rec.end_rendering();
-        }
-        let profiler = rec.profiler.take();
-        // SAFETY: recording finished (also on error, so the buffer is not left recording).
-        unsafe { device.end_command_buffer(commands.cmd) }.map_err(|e| runtime!("vkEndCommandBuffer: {e}"))?;
-        let value = result?;
-        let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(commands.cmd)];
-        let submit = [vk::SubmitInfo2::default().command_buffer_infos(&cmds)];
-        // SAFETY: the queue is used from this thread only; the fence is unsignalled.
-        unsafe {
-            device.queue_submit2(self.queue, &submit, commands.fence).map_err(|e| runtime!("vkQueueSubmit2: {e}"))?;
-            device
-                .wait_for_fences(&[commands.fence], true, u64::MAX)
-                .map_err(|e| runtime!("vkWaitForFences: {e} (device lost?)"))?;
-            device.reset_fences(&[commands.fence]).map_err(|e| runtime!("vkResetFences: {e}"))?;
-        }
-        if let Some(p) = profiler {
-            p.resolve()?;
-        }
-        Ok(value)
-    }
-}
-
-impl Context {
-    /// Records `cmd` (from `pool`, reset first) with `record` and submits it without waiting: it
-    /// waits for `wait` (an acquired swapchain image) before its transfers, signals `signal` (for
-    /// the present) and `fence` (so the caller knows when `cmd` may be recorded again). For
-    /// presentation only: the recorder has no descriptor pool, so it can copy and blit but not
-    /// dispatch or draw.
-    pub(crate) fn submit_presentation(
-        &self,
-        pool: vk::CommandPool,
-        cmd: vk::CommandBuffer,
-        fence: vk::Fence,
-        wait: vk::Semaphore,
-        signal: vk::Semaphore,
-        record: impl FnOnce(&mut Recorder) -> Result<()>,
-    ) -> Result<()> {
-        let device = self.device();
-        // SAFETY: the caller waited for `fence`, so `cmd` is no longer in use.
-        unsafe {
-            device
-                .reset_command_pool(pool, vk::CommandPoolResetFlags::empty())
-                .map_err(|e| runtime!("vkResetCommandPool: {e}"))?;
-            device
-                .begin_command_buffer(
-                    cmd,
-                    &vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
-                )
-                .map_err(|e| runtime!("vkBeginCommandBuffer: {e}"))?;
-        }
-        let mut rec = Recorder {
-            ctx: self,
-            cmd,
-            descriptor_pool: vk::DescriptorPool::null(),
-            profiler: None,
-            inside_rendering: false,
-            open_scopes: Vec::new(),
-        };
-        let result = record(&mut rec);
-        // SAFETY: recording finished (also on error, so the buffer is not left recording).
-        unsafe { device.end_command_buffer(cmd) }.map_err(|e| runtime!("vkEndCommandBuffer: {e}"))?;
-        result?;
-        let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
-        // The swapchain image is first touched by the transfer that clears its layout.
-        let waits =
-            [vk::SemaphoreSubmitInfo::default().semaphore(wait).stage_mask(vk::PipelineStageFlags2::ALL_TRANSFER)];
-        let signals =
-            [vk::SemaphoreSubmitInfo::default().semaphore(signal).stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)];
-        let submit = [vk::SubmitInfo2::default()
-            .command_buffer_infos(&cmds)
-            .wait_semaphore_infos(&waits)
-            .signal_semaphore_infos(&signals)];
-        // SAFETY: the queue is used from this thread only; the fence is reset just before its submission.
-        unsafe {
-            device.reset_fences(&[fence]).map_err(|e| runtime!("vkResetFences: {e}"))?;
-            device.queue_submit2(self.queue, &submit, fence).map_err(|e| runtime!("vkQueueSubmit2: {e}"))?;
-        }
-        Ok(())
-    }
+    /// Barriers declared for the next command, recorded together just before it.
+    pub(super) pending: PendingBarriers,
 }
 
 impl<'a> Recorder<'a> {
+    /// A recorder for `cmd`, which is recording; without a descriptor pool (null) it cannot
+    /// dispatch or draw.
+    pub(super) fn new(
+        ctx: &'a Context,
+        cmd: vk::CommandBuffer,
+        descriptor_pool: vk::DescriptorPool,
+        profiler: Option<&'a mut GpuProfiler>,
+    ) -> Recorder<'a> {
+        Recorder {
+            ctx,
+            cmd,
+            descriptor_pool,
+            profiler,
+            inside_rendering: false,
+            open_scopes: Vec::new(),
+            pending: PendingBarriers::default(),
+        }
+    }
+
+    /// Ends an open rendering scope; the profiler, to resolve after the submission.
+    pub(super) fn finish(mut self) -> Option<&'a mut GpuProfiler> {
+        self.end_rendering();
+        self.profiler.take()
+    }
+
     fn device(&self) -> &ash::Device {
         self.ctx.device()
     }
@@ -255,174 +64,33 @@ impl<'a> Recorder<'a> {
         self.ctx
     }
 
-    fn barrier_check(&self, what: &str) -> Result<()> {
-        if self.inside_rendering {
-            return Err(runtime!(
-                "{what} needs a barrier inside a rendering scope: declare its use before begin_rendering"
-            ));
-        }
-        Ok(())
-    }
-
-    /// Declares that the next commands use `buffer` as `access`, inserting a barrier if needed.
-    pub fn use_buffer(&mut self, buffer: &Buffer, access: Access) -> Result<()> {
-        let mut state = buffer.state.get();
-        let t = state.transition(access, false);
-        buffer.state.set(state);
-        if let Some((ss, sa, ds, da, _, _)) = t {
-            self.barrier_check(&buffer.name)?;
-            let b = [vk::BufferMemoryBarrier2::default()
-                .src_stage_mask(ss)
-                .src_access_mask(sa)
-                .dst_stage_mask(ds)
-                .dst_access_mask(da)
-                .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                .buffer(buffer.raw)
-                .offset(0)
-                .size(vk::WHOLE_SIZE)];
-            // SAFETY: recording into our command buffer.
-            unsafe {
-                self.device().cmd_pipeline_barrier2(self.cmd, &vk::DependencyInfo::default().buffer_memory_barriers(&b))
-            };
-        }
-        Ok(())
-    }
-
-    /// Declares that the next commands use `image` as `access` (in `access.layout`).
-    pub fn use_image(&mut self, image: &Image, access: Access) -> Result<()> {
-        let mut state = image.state.get();
-        let t: Option<Transition> = state.transition(access, true);
-        image.state.set(state);
-        if let Some((ss, sa, ds, da, old, new)) = t {
-            self.barrier_check(&image.name)?;
-            let b = [vk::ImageMemoryBarrier2::default()
-                .src_stage_mask(ss)
-                .src_access_mask(sa)
-                .dst_stage_mask(ds)
-                .dst_access_mask(da)
-                .old_layout(old)
-                .new_layout(new)
-                .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                .image(image.raw)
-                .subresource_range(vk::ImageSubresourceRange {
-                    aspect_mask: aspect_of(image.format),
-                    base_mip_level: 0,
-                    level_count: 1,
-                    base_array_layer: 0,
-                    layer_count: image.layers,
-                })];
-            unsafe {
-                self.device().cmd_pipeline_barrier2(self.cmd, &vk::DependencyInfo::default().image_memory_barriers(&b))
-            };
-        }
-        Ok(())
-    }
-
-    /// Makes the image's contents irrelevant: the next use may start from `UNDEFINED`.
-    pub fn discard_image(&mut self, image: &Image) {
-        let mut state = image.state.get();
-        state.layout = vk::ImageLayout::UNDEFINED;
-        image.state.set(state);
-    }
-
-    /// Allocates and writes set 0 for `pipeline`, transitioning each bound resource for `stage`.
+    /// Checks `binds` and the push constants against `pipeline`, declares each bound resource for
+    /// `stage` (the barriers wait in the pending batch), then binds the pipeline with a new set 0.
     fn bind(&mut self, pipeline: &Pipeline, binds: &[Bind], push_constants: &[u8], stage: Stage) -> Result<()> {
-        if binds.len() != pipeline.bindings.len() {
-            return Err(runtime!(
-                "pipeline {}: {} resources bound, {} declared",
-                pipeline.name,
-                binds.len(),
-                pipeline.bindings.len()
-            ));
-        }
+        pipeline.check_binds(binds)?;
         if push_constants.len() as u32 != pipeline.push_constant_size {
             return Err(runtime!(
-                "pipeline {}: {} bytes of push constants, {} declared",
+                "pipeline {}: {} bytes of push constants, its shaders declare {}",
                 pipeline.name,
                 push_constants.len(),
                 pipeline.push_constant_size
             ));
         }
-        for (i, (bind, kind)) in binds.iter().zip(&pipeline.bindings).enumerate() {
-            let ok = matches!(
-                (bind, kind),
-                (Bind::Read(_) | Bind::Write(_), BindingKind::StorageBuffer)
-                    | (Bind::Uniform(_), BindingKind::UniformBuffer)
-                    | (Bind::Texels(_), BindingKind::TexelBuffer)
-                    | (Bind::Sampled(..), BindingKind::SampledImage)
-                    | (Bind::StorageImageRead(_) | Bind::StorageImageWrite(_), BindingKind::StorageImage)
-            );
-            if !ok {
-                return Err(runtime!(
-                    "pipeline {}: binding {i} does not match its declared kind {kind:?}",
-                    pipeline.name
-                ));
-            }
+        for bind in binds {
             self.declare(bind, stage)?;
         }
+        self.flush_barriers();
         let device = self.ctx.device();
         if !binds.is_empty() {
-            let layouts = [pipeline.set_layout];
-            // SAFETY: pool and layout are valid; the pool is reset only after the fence wait.
-            let set = unsafe {
-                device.allocate_descriptor_sets(
-                    &vk::DescriptorSetAllocateInfo::default()
-                        .descriptor_pool(self.descriptor_pool)
-                        .set_layouts(&layouts),
-                )
-            }
-            .map_err(|e| runtime!("vkAllocateDescriptorSets ({} sets per submission): {e}", SETS_PER_SUBMIT))?[0];
-            let buffer_infos: Vec<[vk::DescriptorBufferInfo; 1]> = binds
-                .iter()
-                .map(|b| match b {
-                    Bind::Read(b) | Bind::Write(b) | Bind::Uniform(b) => {
-                        [vk::DescriptorBufferInfo { buffer: b.raw, offset: 0, range: vk::WHOLE_SIZE }]
-                    }
-                    _ => [vk::DescriptorBufferInfo::default()],
-                })
-                .collect();
-            let image_infos: Vec<[vk::DescriptorImageInfo; 1]> = binds
-                .iter()
-                .map(|b| match b {
-                    Bind::Sampled(img, sampler) => [vk::DescriptorImageInfo {
-                        sampler: sampler.raw,
-                        image_view: img.view,
-                        image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-                    }],
-                    Bind::StorageImageRead(img) | Bind::StorageImageWrite(img) => [vk::DescriptorImageInfo {
-                        sampler: vk::Sampler::null(),
-                        image_view: img.view,
-                        image_layout: vk::ImageLayout::GENERAL,
-                    }],
-                    _ => [vk::DescriptorImageInfo::default()],
-                })
-                .collect();
-            let writes: Vec<_> = binds
-                .iter()
-                .enumerate()
-                .map(|(i, b)| {
-                    let w = vk::WriteDescriptorSet::default()
-                        .dst_set(set)
-                        .dst_binding(i as u32)
-                        .descriptor_type(pipeline.bindings[i].descriptor_type());
-                    match b {
-                        Bind::Read(_) | Bind::Write(_) | Bind::Uniform(_) => w.buffer_info(&buffer_infos[i]),
-                        Bind::Texels(b) => w.texel_buffer_view(std::slice::from_ref(&b.texel_view)),
-                        _ => w.image_info(&image_infos[i]),
-                    }
-                })
-                .collect();
-            unsafe {
-                device.update_descriptor_sets(&writes, &[]);
-                device.cmd_bind_descriptor_sets(self.cmd, pipeline.bind_point, pipeline.layout, 0, &[set], &[]);
-            }
+            let set = write_set(device, self.descriptor_pool, pipeline, binds)?;
+            // SAFETY: the set matches the pipeline's layout and lives until the pool's reset.
+            unsafe { device.cmd_bind_descriptor_sets(self.cmd, pipeline.bind_point, pipeline.layout, 0, &[set], &[]) };
         }
+        // SAFETY: recording into our command buffer; the push-constant range is the layout's.
         unsafe {
             device.cmd_bind_pipeline(self.cmd, pipeline.bind_point, pipeline.raw);
             if !push_constants.is_empty() {
-                device.cmd_push_constants(self.cmd, pipeline.layout, pipeline.stages, 0, push_constants);
+                device.cmd_push_constants(self.cmd, pipeline.layout, pipeline.push_stages, 0, push_constants);
             }
         }
         Ok(())
@@ -461,7 +129,7 @@ impl<'a> Recorder<'a> {
             if clear.is_some() && img.layers == 1 {
                 self.discard_image(img);
             }
-            self.use_image(img, Access::COLOR_ATTACHMENT)?;
+            self.track_image(img, Access::COLOR_ATTACHMENT)?;
         }
         if let Some((img, clear)) = depth {
             // A layout transition from UNDEFINED would discard every layer, not just this one.
@@ -470,8 +138,9 @@ impl<'a> Recorder<'a> {
             }
             let access =
                 if has_stencil(img.format) { Access::DEPTH_STENCIL_ATTACHMENT } else { Access::DEPTH_ATTACHMENT };
-            self.use_image(img, access)?;
+            self.track_image(img, access)?;
         }
+        self.flush_barriers();
         // A depth format with stencil is attached as both (stencil cleared to 0 with the depth).
         let stencil = depth.is_some_and(|(img, _)| has_stencil(img.format));
         let extent = colors.first().map(|c| c.0.extent).or(depth.map(|d| d.0.extent)).unwrap_or_default();
@@ -530,7 +199,7 @@ impl<'a> Recorder<'a> {
             min_depth: 0.0,
             max_depth: 1.0,
         };
-        // SAFETY: attachments are in the layouts named above (barriers recorded by use_image).
+        // SAFETY: attachments are in the layouts named above (barriers recorded just above).
         unsafe {
             self.device().cmd_begin_rendering(self.cmd, &info);
             self.device().cmd_set_viewport(self.cmd, 0, &[viewport]);
@@ -579,10 +248,10 @@ impl<'a> Recorder<'a> {
             return Err(runtime!("draw with {} outside a rendering scope", pipeline.name));
         }
         if let Some(v) = vertices {
-            self.use_buffer(v, Access::VERTEX_INPUT)?;
+            self.track_buffer(v, BufferAccess::VERTEX_INPUT)?;
         }
         if let Some(i) = indices {
-            self.use_buffer(i, Access::INDEX_INPUT)?;
+            self.track_buffer(i, BufferAccess::INDEX_INPUT)?;
         }
         self.bind(pipeline, binds, push_constants, Stage::Graphics)?;
         // SAFETY: graphics pipeline bound inside a rendering scope.
@@ -604,28 +273,33 @@ impl<'a> Recorder<'a> {
     /// Declares the resources of a later draw before its rendering scope begins (barriers cannot
     /// be recorded inside one).
     pub fn prepare_draw_reads(&mut self, binds: &[Bind]) -> Result<()> {
-        binds.iter().try_for_each(|bind| self.declare(bind, Stage::Graphics))
+        binds.iter().try_for_each(|bind| self.declare(bind, Stage::Graphics))?;
+        self.flush_barriers();
+        Ok(())
     }
 
-    /// Declares how the shaders of `stage` use a bound resource, recording a barrier if needed.
+    /// Declares how the shaders of `stage` use a bound resource; a barrier, if needed, joins the
+    /// pending batch.
     fn declare(&mut self, bind: &Bind, stage: Stage) -> Result<()> {
         // Inside a rendering scope, a write declared before begin_rendering (prepare_draw_reads)
         // is already ordered: declaring it again for the draw is not a new hazard.
-        let declared_write = |b: &Buffer| self.inside_rendering && b.state.get().last_write == stage.write();
+        let declared_write = |b: &Buffer| self.inside_rendering && b.state.get().last_write == stage.write().memory();
         match bind {
-            Bind::Read(b) => self.use_buffer(b, stage.read()),
+            Bind::Read(b) => self.track_buffer(b, stage.read().memory()),
             Bind::Write(b) if declared_write(b) => Ok(()),
-            Bind::Write(b) => self.use_buffer(b, stage.write()),
-            Bind::Uniform(b) => self.use_buffer(b, Access { stage: stage.flags(), ..Access::UNIFORM_READ }),
+            Bind::Write(b) => self.track_buffer(b, stage.write().memory()),
+            Bind::Uniform(b) => {
+                self.track_buffer(b, BufferAccess { stage: stage.flags(), ..BufferAccess::UNIFORM_READ })
+            }
             Bind::Texels(b) => {
                 if b.texel_view == vk::BufferView::null() {
                     return Err(runtime!("buffer {} has no texel view (made without UNIFORM_TEXEL_BUFFER)", b.name));
                 }
-                self.use_buffer(b, Access { stage: stage.flags(), ..Access::TEXEL_READ })
+                self.track_buffer(b, BufferAccess { stage: stage.flags(), ..BufferAccess::TEXEL_READ })
             }
-            Bind::Sampled(img, _) => self.use_image(img, stage.sampled()),
-            Bind::StorageImageRead(img) => self.use_image(img, stage.read()),
-            Bind::StorageImageWrite(img) => self.use_image(img, stage.write()),
+            Bind::Sampled(img, _) => self.track_image(img, stage.sampled()),
+            Bind::StorageImageRead(img) => self.track_image(img, stage.read()),
+            Bind::StorageImageWrite(img) => self.track_image(img, stage.write()),
         }
     }
 
@@ -639,23 +313,25 @@ impl<'a> Recorder<'a> {
                 dst.size
             ));
         }
-        self.use_buffer(src, Access { layout: vk::ImageLayout::UNDEFINED, ..Access::TRANSFER_READ })?;
-        self.use_buffer(dst, Access { layout: vk::ImageLayout::UNDEFINED, ..Access::TRANSFER_WRITE })?;
+        self.track_buffer(src, BufferAccess::TRANSFER_READ)?;
+        self.track_buffer(dst, BufferAccess::TRANSFER_WRITE)?;
+        self.flush_barriers();
         let region = [vk::BufferCopy { src_offset: 0, dst_offset: 0, size: bytes }];
         unsafe { self.device().cmd_copy_buffer(self.cmd, src.raw, dst.raw, &region) };
         Ok(())
     }
 
     pub fn fill_buffer(&mut self, dst: &Buffer, value: u32) -> Result<()> {
-        self.use_buffer(dst, Access { layout: vk::ImageLayout::UNDEFINED, ..Access::TRANSFER_WRITE })?;
+        self.use_buffer(dst, BufferAccess::TRANSFER_WRITE)?;
         unsafe { self.device().cmd_fill_buffer(self.cmd, dst.raw, 0, vk::WHOLE_SIZE, value) };
         Ok(())
     }
 
     /// Copies layer 0 of a colour image into a buffer, tightly packed, then makes it host-readable.
     pub fn copy_image_to_buffer(&mut self, src: &Image, dst: &Buffer) -> Result<()> {
-        self.use_image(src, Access::TRANSFER_READ)?;
-        self.use_buffer(dst, Access { layout: vk::ImageLayout::UNDEFINED, ..Access::TRANSFER_WRITE })?;
+        self.track_image(src, Access::TRANSFER_READ)?;
+        self.track_buffer(dst, BufferAccess::TRANSFER_WRITE)?;
+        self.flush_barriers();
         let region = [layer0_region(src)];
         unsafe {
             self.device().cmd_copy_image_to_buffer(
@@ -666,7 +342,7 @@ impl<'a> Recorder<'a> {
                 &region,
             )
         };
-        self.use_buffer(dst, Access::HOST_READ)
+        self.use_buffer(dst, BufferAccess::HOST_READ)
     }
 
     /// Fills layer 0 of a colour image from a tightly packed buffer (uploads, tests); the image's
@@ -681,9 +357,10 @@ impl<'a> Recorder<'a> {
         if src.size < bytes {
             return Err(runtime!("copy of {} ({} bytes) into {} needs {bytes} bytes", src.name, src.size, dst.name));
         }
-        self.use_buffer(src, Access { layout: vk::ImageLayout::UNDEFINED, ..Access::TRANSFER_READ })?;
+        self.track_buffer(src, BufferAccess::TRANSFER_READ)?;
         self.discard_image(dst);
-        self.use_image(dst, Access::TRANSFER_WRITE)?;
+        self.track_image(dst, Access::TRANSFER_WRITE)?;
+        self.flush_barriers();
         let region = [layer0_region(dst)];
         // SAFETY: the image is in TRANSFER_DST_OPTIMAL (barrier above); the buffer holds the region.
         unsafe {
@@ -820,7 +497,7 @@ impl<'a> Recorder<'a> {
 
     /// Makes a buffer written on the GPU readable by the host after the submission's fence.
     pub fn host_read(&mut self, buffer: &Buffer) -> Result<()> {
-        self.use_buffer(buffer, Access::HOST_READ)
+        self.use_buffer(buffer, BufferAccess::HOST_READ)
     }
 
     /// Opens a named timestamp scope (no-op without a profiler). Scopes may nest.
@@ -883,5 +560,3 @@ impl Stage {
         Access { stage: self.flags(), ..Access::COMPUTE_SAMPLED }
     }
 }
-
-pub(crate) type CommandsCell = RefCell<Commands>;

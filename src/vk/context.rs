@@ -12,7 +12,8 @@ use std::sync::{Arc, Mutex};
 use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 
-use crate::error::{Error, Result};
+use super::guard::Guard;
+use crate::error::Result;
 use crate::{bad_input, runtime};
 
 const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
@@ -79,11 +80,14 @@ impl DeviceInfo {
     }
 }
 
+/// The debug-utils loader and the messenger made with it.
+type Messenger = (ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT);
+
 /// Objects destroyed together, in reverse creation order, when the last owner drops.
 pub struct Shared {
     pub(crate) entry: ash::Entry,
     pub(crate) instance: ash::Instance,
-    debug: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
+    debug: Option<Messenger>,
     pub(crate) device: ash::Device,
     pub(crate) allocator: ManuallyDrop<Mutex<Allocator>>,
     /// Keeps the callback's user data alive until after `vkDestroyInstance`.
@@ -118,7 +122,7 @@ pub struct Context {
     pub has_shader_int64: bool,
     counts: Arc<ValidationCounts>,
     pub validation: bool,
-    pub(crate) commands: super::commands::CommandsCell,
+    pub(crate) commands: super::submit::CommandsCell,
 }
 
 impl Drop for Context {
@@ -368,82 +372,46 @@ impl Context {
             None => &[],
         };
         let (instance, messenger_wanted) = create_instance(&entry, options.validation, &counts, window_extensions)?;
-        // From here on, any early return must destroy the instance: wrap it at once.
-        let cleanup_instance = |e: Error| {
-            // SAFETY: nothing else uses the instance on this error path.
-            unsafe { instance.destroy_instance(None) };
-            e
-        };
+        // From here on, an early return drops the guards, which destroy what was made so far
+        // (messenger, then instance); `create_device` defuses them once the context owns both.
+        // SAFETY (cleanup): on an error path nothing else uses the instance.
+        let instance = Guard::new(instance, |i: ash::Instance| unsafe { i.destroy_instance(None) });
 
         let debug = if messenger_wanted {
             let loader = ash::ext::debug_utils::Instance::new(&entry, &instance);
             // SAFETY: the create-info points to `counts`, which outlives the messenger.
-            match unsafe { loader.create_debug_utils_messenger(&messenger_create_info(&counts), None) } {
-                Ok(m) => Some((loader, m)),
-                Err(e) => return Err(cleanup_instance(runtime!("vkCreateDebugUtilsMessengerEXT: {e}"))),
-            }
+            let messenger = unsafe { loader.create_debug_utils_messenger(&messenger_create_info(&counts), None) }
+                .map_err(|e| runtime!("vkCreateDebugUtilsMessengerEXT: {e}"))?;
+            Some((loader, messenger))
         } else {
             None
         };
-        let destroy_debug = |debug: &Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>| {
+        let debug = Guard::new(debug, |debug: Option<Messenger>| {
             if let Some((loader, m)) = debug {
                 // SAFETY: error path; the messenger is not used afterwards.
-                unsafe { loader.destroy_debug_utils_messenger(*m, None) };
+                unsafe { loader.destroy_debug_utils_messenger(m, None) };
             }
-        };
+        });
 
-        let devices = match describe_devices(&instance) {
-            Ok(d) => d,
-            Err(e) => {
-                destroy_debug(&debug);
-                return Err(cleanup_instance(e));
-            }
-        };
-        let (pd, info) = match choose_device(&devices, options.device.as_deref()) {
-            Ok(x) => x,
-            Err(e) => {
-                destroy_debug(&debug);
-                return Err(cleanup_instance(e));
-            }
-        };
+        let devices = describe_devices(&instance)?;
+        let (pd, info) = choose_device(&devices, options.device.as_deref())?;
         let swapchain = display.is_some();
-        match Self::create_device(
-            entry.clone(),
-            instance.clone(),
-            debug,
-            pd,
-            info,
-            counts,
-            options.validation,
-            swapchain,
-        ) {
-            Ok(ctx) => Ok(ctx),
-            // create_device has already destroyed the messenger and the instance on failure.
-            Err(e) => Err(e),
-        }
+        Self::create_device(entry.clone(), instance, debug, pd, info, counts, options.validation, swapchain)
     }
 
+    /// The logical device and what hangs off it. `instance` and `debug` are guarded: any error
+    /// return destroys them, after the objects made here (the parameters drop last).
     #[allow(clippy::too_many_arguments)]
     fn create_device(
         entry: ash::Entry,
-        instance: ash::Instance,
-        debug: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
+        instance: Guard<ash::Instance, impl FnOnce(ash::Instance)>,
+        debug: Guard<Option<Messenger>, impl FnOnce(Option<Messenger>)>,
         pd: vk::PhysicalDevice,
         info: DeviceInfo,
         counts: Arc<ValidationCounts>,
         validation: bool,
         swapchain: bool,
     ) -> Result<Context> {
-        let fail = |debug: &Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>, e: Error| {
-            // SAFETY: error path: nothing else uses these handles.
-            unsafe {
-                if let Some((loader, m)) = debug {
-                    loader.destroy_debug_utils_messenger(*m, None);
-                }
-                instance.destroy_instance(None);
-            }
-            e
-        };
         let (queue_family, timestamp_valid_bits) = find_queue_family(&instance, pd).expect("checked by choose_device");
         // SAFETY: valid physical device.
         let properties = unsafe { instance.get_physical_device_properties(pd) };
@@ -477,10 +445,7 @@ impl Context {
             missing.push("fragmentStoresAndAtomics");
         }
         if !missing.is_empty() {
-            return Err(fail(
-                &debug,
-                runtime!("device {} lacks required Vulkan features: {}", info.name, missing.join(", ")),
-            ));
+            return Err(runtime!("device {} lacks required Vulkan features: {}", info.name, missing.join(", ")));
         }
         let has_shader_int64 = have10.shader_int64 == vk::TRUE;
 
@@ -503,10 +468,7 @@ impl Context {
             // SAFETY: valid physical device.
             let available = unsafe { instance.enumerate_device_extension_properties(pd) }.unwrap_or_default();
             if !available.iter().any(|e| e.extension_name_as_c_str().ok() == Some(ash::khr::swapchain::NAME)) {
-                return Err(fail(
-                    &debug,
-                    runtime!("device {} cannot present to a window (no VK_KHR_swapchain)", info.name),
-                ));
+                return Err(runtime!("device {} cannot present to a window (no VK_KHR_swapchain)", info.name));
             }
         }
         let device_info = vk::DeviceCreateInfo::default()
@@ -516,41 +478,34 @@ impl Context {
             .push_next(&mut features12)
             .push_next(&mut features13);
         // SAFETY: create-info points to locals alive for the call.
-        let device = match unsafe { instance.create_device(pd, &device_info, None) } {
-            Ok(d) => d,
-            Err(e) => return Err(fail(&debug, runtime!("vkCreateDevice on {}: {e}", info.name))),
-        };
+        let device = unsafe { instance.create_device(pd, &device_info, None) }
+            .map_err(|e| runtime!("vkCreateDevice on {}: {e}", info.name))?;
+        // SAFETY (cleanup): on an error path nothing else uses the device.
+        let device = Guard::new(device, |d: ash::Device| unsafe { d.destroy_device(None) });
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
-        let commands = match super::commands::Commands::new(&device, queue_family) {
-            Ok(c) => c,
-            Err(e) => {
-                unsafe { device.destroy_device(None) };
-                return Err(fail(&debug, e));
-            }
-        };
+        let commands = super::submit::Commands::new(&device, queue_family)?;
+        let commands = Guard::new(commands, {
+            let device = (*device).clone();
+            move |mut c: super::submit::Commands| c.destroy(&device)
+        });
 
-        let allocator = match Allocator::new(&AllocatorCreateDesc {
-            instance: instance.clone(),
-            device: device.clone(),
+        let allocator = Allocator::new(&AllocatorCreateDesc {
+            instance: (*instance).clone(),
+            device: (*device).clone(),
             physical_device: pd,
             debug_settings: Default::default(),
             buffer_device_address: false,
             allocation_sizes: Default::default(),
-        }) {
-            Ok(a) => a,
-            Err(e) => {
-                let mut commands = commands;
-                commands.destroy(&device);
-                unsafe { device.destroy_device(None) };
-                return Err(fail(&debug, runtime!("gpu-allocator: {e}")));
-            }
-        };
+        })
+        .map_err(|e| runtime!("gpu-allocator: {e}"))?;
 
+        // Everything exists: `Shared` and the context own it from here on.
+        let commands = commands.defuse();
         let shared = Arc::new(Shared {
             entry,
-            instance,
-            debug,
-            device,
+            device: device.defuse(),
+            debug: debug.defuse(),
+            instance: instance.defuse(),
             allocator: ManuallyDrop::new(Mutex::new(allocator)),
             _counts: counts.clone(),
         });

@@ -2,21 +2,27 @@
 //! [`Context`], [`Buffer`], [`Image`], [`Pipeline`], and a [`Recorder`] that turns declared
 //! resource uses into synchronization2 barriers.
 
+mod barriers;
 mod commands;
 mod context;
+mod descriptors;
+mod guard;
 mod overlay;
 mod pipeline;
 mod profiler;
 mod resources;
+mod submit;
 mod swapchain;
 
 pub use ash::vk::{BufferUsageFlags, CullModeFlags, Extent2D, Format, ImageUsageFlags, PrimitiveTopology};
-pub use commands::{Bind, Recorder};
+pub use barriers::{Access, BufferAccess};
+pub use commands::Recorder;
 pub use context::{list_devices, Context, ContextOptions, DeviceInfo, ValidationCounts};
+pub use descriptors::Bind;
 pub use overlay::{Overlay, OverlayFrame};
-pub use pipeline::{check_all_shaders, BindingKind, GraphicsDesc, Pipeline};
+pub use pipeline::{check_all_shaders, GraphicsDesc, Pipeline};
 pub use profiler::{GpuProfiler, TimedScope};
-pub use resources::{Access, Buffer, Image, MemoryLocation, Sampler};
+pub use resources::{Buffer, Image, MemoryLocation, Sampler};
 pub use swapchain::{PresentMode, Presented, Presenter, FRAMES_IN_FLIGHT};
 
 /// Reinterprets a plain value as bytes for push constants.

@@ -1,7 +1,8 @@
 //! Shader modules, descriptor-set layouts and compute / graphics pipelines (dynamic rendering).
 //!
-//! A pipeline declares its bindings as a list of [`BindingKind`]s (binding i = entry i, set 0) and
-//! a push-constant size; the recorder allocates and writes a descriptor set per use.
+//! A pipeline's layout comes from its shaders: set 0's bindings and the push-constant range are
+//! the union of what each stage's SPIR-V declares ([`crate::shaders::reflect`]). The recorder
+//! checks each use's [`Bind`](super::Bind) list against it, then allocates and writes a set.
 
 use std::sync::Arc;
 
@@ -10,27 +11,28 @@ use ash::vk;
 use super::context::{Context, Shared};
 use crate::error::Result;
 use crate::runtime;
+use crate::shaders::{DescriptorKind, Stage};
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum BindingKind {
-    StorageBuffer,
-    UniformBuffer,
-    /// Combined image + sampler.
-    SampledImage,
-    StorageImage,
-    /// A buffer read as RGBA32UI texels (`usamplerBuffer`).
-    TexelBuffer,
+/// One binding of a pipeline's set 0, merged over the stages that declare it.
+#[derive(Clone, Debug)]
+pub(crate) struct LayoutBinding {
+    pub kind: DescriptorKind,
+    /// No stage writes through it (`readonly` everywhere it is declared).
+    pub read_only: bool,
+    pub stages: vk::ShaderStageFlags,
+    /// The shaders that declare it and its name there, for errors: `shade.frag (work)`.
+    pub declared_in: String,
 }
 
-impl BindingKind {
-    pub(crate) fn descriptor_type(self) -> vk::DescriptorType {
-        match self {
-            BindingKind::StorageBuffer => vk::DescriptorType::STORAGE_BUFFER,
-            BindingKind::UniformBuffer => vk::DescriptorType::UNIFORM_BUFFER,
-            BindingKind::SampledImage => vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
-            BindingKind::StorageImage => vk::DescriptorType::STORAGE_IMAGE,
-            BindingKind::TexelBuffer => vk::DescriptorType::UNIFORM_TEXEL_BUFFER,
-        }
+pub(crate) fn descriptor_type(kind: DescriptorKind) -> vk::DescriptorType {
+    match kind {
+        DescriptorKind::StorageBuffer => vk::DescriptorType::STORAGE_BUFFER,
+        DescriptorKind::UniformBuffer => vk::DescriptorType::UNIFORM_BUFFER,
+        DescriptorKind::CombinedImageSampler => vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+        DescriptorKind::SampledImage => vk::DescriptorType::SAMPLED_IMAGE,
+        DescriptorKind::StorageImage => vk::DescriptorType::STORAGE_IMAGE,
+        DescriptorKind::Sampler => vk::DescriptorType::SAMPLER,
+        DescriptorKind::UniformTexelBuffer => vk::DescriptorType::UNIFORM_TEXEL_BUFFER,
     }
 }
 
@@ -40,9 +42,11 @@ pub struct Pipeline {
     pub(crate) layout: vk::PipelineLayout,
     pub(crate) set_layout: vk::DescriptorSetLayout,
     pub(crate) bind_point: vk::PipelineBindPoint,
-    pub(crate) bindings: Vec<BindingKind>,
+    /// Binding i of set 0 is entry i (the shaders' bindings are numbered 0..n without gaps).
+    pub(crate) bindings: Vec<LayoutBinding>,
     pub(crate) push_constant_size: u32,
-    pub(crate) stages: vk::ShaderStageFlags,
+    /// The stages that declare the push-constant block.
+    pub(crate) push_stages: vk::ShaderStageFlags,
     pub name: String,
 }
 
@@ -58,21 +62,33 @@ impl Drop for Pipeline {
     }
 }
 
-/// A shader module that lives only while pipelines are created from it.
+/// A shader module that lives only while pipelines are created from it, with its reflection.
 struct Module<'a> {
     device: &'a ash::Device,
     raw: vk::ShaderModule,
+    name: &'a str,
+    reflection: crate::shaders::Reflection,
 }
 
 impl<'a> Module<'a> {
-    fn new(ctx: &'a Context, name: &str) -> Result<Module<'a>> {
+    fn new(ctx: &'a Context, name: &'a str) -> Result<Module<'a>> {
         let code =
             crate::shaders::spirv(name).ok_or_else(|| runtime!("shader {name} is not embedded in the binary"))?;
+        let reflection = crate::shaders::reflect_spirv(&code).map_err(|e| runtime!("shader {name}: {e}"))?;
         let info = vk::ShaderModuleCreateInfo::default().code(&code);
         // SAFETY: the SPIR-V was produced and validated by shaderc at build time.
         let raw = unsafe { ctx.device().create_shader_module(&info, None) }
             .map_err(|e| runtime!("vkCreateShaderModule {name}: {e}"))?;
-        Ok(Module { device: ctx.device(), raw })
+        Ok(Module { device: ctx.device(), raw, name, reflection })
+    }
+
+    /// The module, checked to be a shader of `stage`.
+    fn expect(self, stage: vk::ShaderStageFlags) -> Result<Module<'a>> {
+        let found = stage_flags(self.reflection.stage);
+        if found != stage {
+            return Err(runtime!("shader {} is a {found:?} shader, used as {stage:?}", self.name));
+        }
+        Ok(self)
     }
 }
 
@@ -82,8 +98,17 @@ impl Drop for Module<'_> {
     }
 }
 
+fn stage_flags(stage: Stage) -> vk::ShaderStageFlags {
+    match stage {
+        Stage::Vertex => vk::ShaderStageFlags::VERTEX,
+        Stage::Fragment => vk::ShaderStageFlags::FRAGMENT,
+        Stage::Compute => vk::ShaderStageFlags::COMPUTE,
+        Stage::Other(_) => vk::ShaderStageFlags::empty(),
+    }
+}
+
 /// Creates and destroys a shader module for every embedded shader, so the driver (and the
-/// validation layer) see each one. Returns the names checked.
+/// validation layer) see each one, and reflects each. Returns the names checked.
 pub fn check_all_shaders(ctx: &Context) -> Result<Vec<&'static str>> {
     let mut names = Vec::new();
     for name in crate::shaders::names() {
@@ -93,92 +118,192 @@ pub fn check_all_shaders(ctx: &Context) -> Result<Vec<&'static str>> {
     Ok(names)
 }
 
-/// Creates the set-0 layout and the pipeline layout for `bindings` and `push_constant_size`.
-fn layouts(
-    ctx: &Context,
-    bindings: &[BindingKind],
+/// What a pipeline's stages declare together: set 0's bindings and the push-constant block.
+struct ShaderLayout {
+    bindings: Vec<LayoutBinding>,
     push_constant_size: u32,
-    stages: vk::ShaderStageFlags,
-) -> Result<(vk::DescriptorSetLayout, vk::PipelineLayout)> {
-    let device = ctx.device();
-    let vk_bindings: Vec<_> = bindings
-        .iter()
-        .enumerate()
-        .map(|(i, kind)| {
-            vk::DescriptorSetLayoutBinding::default()
-                .binding(i as u32)
-                .descriptor_type(kind.descriptor_type())
-                .descriptor_count(1)
-                .stage_flags(stages)
-        })
-        .collect();
-    let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&vk_bindings);
-    // SAFETY: valid device.
-    let set_layout = unsafe { device.create_descriptor_set_layout(&info, None) }
-        .map_err(|e| runtime!("vkCreateDescriptorSetLayout: {e}"))?;
-    let ranges = [vk::PushConstantRange { stage_flags: stages, offset: 0, size: push_constant_size }];
-    let set_layouts = [set_layout];
-    let mut layout_info = vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts);
-    if push_constant_size > 0 {
-        layout_info = layout_info.push_constant_ranges(&ranges);
+    push_stages: vk::ShaderStageFlags,
+}
+
+/// Merges the reflection of a pipeline's modules. A binding declared by several stages must have
+/// one kind; it is read-only if every stage declares it so.
+fn merge_reflection(pipeline: &str, modules: &[&Module]) -> Result<ShaderLayout> {
+    let mut bindings: Vec<Option<LayoutBinding>> = Vec::new();
+    let (mut push_constant_size, mut push_stages) = (0, vk::ShaderStageFlags::empty());
+    for module in modules {
+        let stage = stage_flags(module.reflection.stage);
+        for b in &module.reflection.bindings {
+            let at = format!("pipeline {pipeline}: {} set {} binding {} ({})", module.name, b.set, b.binding, b.name);
+            if b.set != 0 {
+                return Err(runtime!("{at}: only descriptor set 0 is supported"));
+            }
+            if b.count != 1 {
+                return Err(runtime!("{at}: arrays of descriptors are not supported"));
+            }
+            if matches!(b.kind, DescriptorKind::SampledImage | DescriptorKind::Sampler) {
+                return Err(runtime!("{at}: {:?} descriptors are not supported (use a combined sampler)", b.kind));
+            }
+            let i = b.binding as usize;
+            if bindings.len() <= i {
+                bindings.resize(i + 1, None);
+            }
+            let declared_in = format!("{} ({})", module.name, b.name);
+            match &mut bindings[i] {
+                None => {
+                    bindings[i] =
+                        Some(LayoutBinding { kind: b.kind, read_only: b.read_only, stages: stage, declared_in })
+                }
+                Some(merged) if merged.kind == b.kind => {
+                    merged.read_only &= b.read_only;
+                    merged.stages |= stage;
+                    merged.declared_in = format!("{}, {declared_in}", merged.declared_in);
+                }
+                Some(merged) => {
+                    return Err(runtime!(
+                        "{at}: declared as {:?}, but as {:?} in {}",
+                        b.kind,
+                        merged.kind,
+                        merged.declared_in
+                    ))
+                }
+            }
+        }
+        if module.reflection.push_constants.is_some() {
+            push_constant_size = push_constant_size.max(module.reflection.push_constant_size());
+            push_stages |= stage;
+        }
     }
-    match unsafe { device.create_pipeline_layout(&layout_info, None) } {
-        Ok(layout) => Ok((set_layout, layout)),
-        Err(e) => {
-            unsafe { device.destroy_descriptor_set_layout(set_layout, None) };
-            Err(runtime!("vkCreatePipelineLayout: {e}"))
+    let bindings = bindings
+        .into_iter()
+        .enumerate()
+        .map(|(i, b)| {
+            b.ok_or_else(|| {
+                runtime!("pipeline {pipeline}: no shader declares binding {i}, but a higher one: number them 0..n")
+            })
+        })
+        .collect::<Result<_>>()?;
+    Ok(ShaderLayout { bindings, push_constant_size, push_stages })
+}
+
+/// A pipeline's merged reflection with its set-0 layout and pipeline layout, which are destroyed
+/// on drop unless a pipeline takes them ([`Layouts::into_pipeline`]).
+struct Layouts<'a> {
+    device: &'a ash::Device,
+    shader: ShaderLayout,
+    set_layout: vk::DescriptorSetLayout,
+    layout: vk::PipelineLayout,
+}
+
+impl Drop for Layouts<'_> {
+    fn drop(&mut self) {
+        // SAFETY: no pipeline took the layouts, so nothing else uses them; null handles are ignored.
+        unsafe {
+            self.device.destroy_pipeline_layout(self.layout, None);
+            self.device.destroy_descriptor_set_layout(self.set_layout, None);
         }
     }
 }
 
-fn check_push_size(ctx: &Context, name: &str, size: u32) -> Result<()> {
-    let max = ctx.limits().max_push_constants_size;
-    if size > max {
-        return Err(runtime!("pipeline {name}: {size} bytes of push constants exceed the device's {max}"));
+impl Layouts<'_> {
+    /// Creates the set-0 layout and the pipeline layout that `modules` declare together.
+    fn new<'a>(ctx: &'a Context, name: &str, modules: &[&Module]) -> Result<Layouts<'a>> {
+        let shader = merge_reflection(name, modules)?;
+        let max = ctx.limits().max_push_constants_size;
+        if shader.push_constant_size > max {
+            return Err(runtime!(
+                "pipeline {name}: {} bytes of push constants exceed the device's {max}",
+                shader.push_constant_size
+            ));
+        }
+        let device = ctx.device();
+        let vk_bindings: Vec<_> = shader
+            .bindings
+            .iter()
+            .enumerate()
+            .map(|(i, b)| {
+                vk::DescriptorSetLayoutBinding::default()
+                    .binding(i as u32)
+                    .descriptor_type(descriptor_type(b.kind))
+                    .descriptor_count(1)
+                    .stage_flags(b.stages)
+            })
+            .collect();
+        let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&vk_bindings);
+        // SAFETY: valid device.
+        let set_layout = unsafe { device.create_descriptor_set_layout(&info, None) }
+            .map_err(|e| runtime!("vkCreateDescriptorSetLayout: {e}"))?;
+        let mut layouts = Layouts { device, shader, set_layout, layout: vk::PipelineLayout::null() };
+        let ranges = [vk::PushConstantRange {
+            stage_flags: layouts.shader.push_stages,
+            offset: 0,
+            size: layouts.shader.push_constant_size,
+        }];
+        let set_layouts = [set_layout];
+        let mut layout_info = vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts);
+        if layouts.shader.push_constant_size > 0 {
+            layout_info = layout_info.push_constant_ranges(&ranges);
+        }
+        // SAFETY: valid device; the create-info points to locals alive for the call.
+        layouts.layout = unsafe { device.create_pipeline_layout(&layout_info, None) }
+            .map_err(|e| runtime!("vkCreatePipelineLayout: {e}"))?;
+        Ok(layouts)
     }
-    Ok(())
+
+    /// The pipeline was created: it owns the layouts from now on.
+    fn into_pipeline(
+        mut self,
+        ctx: &Context,
+        raw: vk::Pipeline,
+        bind_point: vk::PipelineBindPoint,
+        name: String,
+    ) -> Pipeline {
+        let shader = std::mem::replace(
+            &mut self.shader,
+            ShaderLayout { bindings: Vec::new(), push_constant_size: 0, push_stages: vk::ShaderStageFlags::empty() },
+        );
+        Pipeline {
+            shared: ctx.shared.clone(),
+            raw,
+            layout: std::mem::take(&mut self.layout),
+            set_layout: std::mem::take(&mut self.set_layout),
+            bind_point,
+            bindings: shader.bindings,
+            push_constant_size: shader.push_constant_size,
+            push_stages: shader.push_stages,
+            name,
+        }
+    }
 }
 
 impl Pipeline {
-    pub fn compute(ctx: &Context, shader: &str, bindings: &[BindingKind], push_constant_size: u32) -> Result<Pipeline> {
-        check_push_size(ctx, shader, push_constant_size)?;
-        let module = Module::new(ctx, shader)?;
-        let stages = vk::ShaderStageFlags::COMPUTE;
-        let (set_layout, layout) = layouts(ctx, bindings, push_constant_size, stages)?;
-        let stage = vk::PipelineShaderStageCreateInfo::default().stage(stages).module(module.raw).name(c"main");
-        let info = [vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout)];
+    /// A compute pipeline running `shader` (its path under `shaders/`); its layout is what the
+    /// shader declares.
+    pub fn compute(ctx: &Context, shader: &str) -> Result<Pipeline> {
+        let module = Module::new(ctx, shader)?.expect(vk::ShaderStageFlags::COMPUTE)?;
+        let layouts = Layouts::new(ctx, shader, &[&module])?;
+        let stage = vk::PipelineShaderStageCreateInfo::default()
+            .stage(vk::ShaderStageFlags::COMPUTE)
+            .module(module.raw)
+            .name(c"main");
+        let info = [vk::ComputePipelineCreateInfo::default().stage(stage).layout(layouts.layout)];
         // SAFETY: valid module and layout.
-        let raw = unsafe { ctx.device().create_compute_pipelines(vk::PipelineCache::null(), &info, None) };
-        let raw = match raw {
-            Ok(p) => p[0],
-            Err((_, e)) => {
-                unsafe {
-                    ctx.device().destroy_pipeline_layout(layout, None);
-                    ctx.device().destroy_descriptor_set_layout(set_layout, None);
-                }
-                return Err(runtime!("compute pipeline {shader}: {e}"));
-            }
-        };
-        Ok(Pipeline {
-            shared: ctx.shared.clone(),
-            raw,
-            layout,
-            set_layout,
-            bind_point: vk::PipelineBindPoint::COMPUTE,
-            bindings: bindings.to_vec(),
-            push_constant_size,
-            stages,
-            name: shader.to_string(),
-        })
+        let raw = unsafe { ctx.device().create_compute_pipelines(vk::PipelineCache::null(), &info, None) }
+            .map_err(|(_, e)| runtime!("compute pipeline {shader}: {e}"))?[0];
+        Ok(layouts.into_pipeline(ctx, raw, vk::PipelineBindPoint::COMPUTE, shader.to_string()))
+    }
+
+    /// The number of bytes of push constants each use must give (0 without a block).
+    pub fn push_constant_size(&self) -> u32 {
+        self.push_constant_size
     }
 
     pub fn graphics(ctx: &Context, desc: &GraphicsDesc) -> Result<Pipeline> {
         let name = format!("{}+{}", desc.vertex_shader, desc.fragment_shader.unwrap_or("-"));
-        check_push_size(ctx, &name, desc.push_constant_size)?;
-        let vert = Module::new(ctx, desc.vertex_shader)?;
-        let frag = desc.fragment_shader.map(|f| Module::new(ctx, f)).transpose()?;
-        let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
-        let (set_layout, layout) = layouts(ctx, desc.bindings, desc.push_constant_size, stages)?;
+        let vert = Module::new(ctx, desc.vertex_shader)?.expect(vk::ShaderStageFlags::VERTEX)?;
+        let frag =
+            desc.fragment_shader.map(|f| Module::new(ctx, f)?.expect(vk::ShaderStageFlags::FRAGMENT)).transpose()?;
+        let modules: Vec<&Module> = std::iter::once(&vert).chain(&frag).collect();
+        let layouts = Layouts::new(ctx, &name, &modules)?;
 
         // Specialisation constant i (constant_id = i) of both stages is desc.specialization[i].
         let entries: Vec<vk::SpecializationMapEntry> = (0..desc.specialization.len() as u32)
@@ -292,34 +417,17 @@ impl Pipeline {
             .depth_stencil_state(&depth)
             .color_blend_state(&blend)
             .dynamic_state(&dynamic)
-            .layout(layout)
+            .layout(layouts.layout)
             .push_next(&mut rendering)];
         // SAFETY: every pointer refers to locals alive for the call.
-        let raw = match unsafe { ctx.device().create_graphics_pipelines(vk::PipelineCache::null(), &info, None) } {
-            Ok(p) => p[0],
-            Err((_, e)) => {
-                unsafe {
-                    ctx.device().destroy_pipeline_layout(layout, None);
-                    ctx.device().destroy_descriptor_set_layout(set_layout, None);
-                }
-                return Err(runtime!("graphics pipeline {name}: {e}"));
-            }
-        };
-        Ok(Pipeline {
-            shared: ctx.shared.clone(),
-            raw,
-            layout,
-            set_layout,
-            bind_point: vk::PipelineBindPoint::GRAPHICS,
-            bindings: desc.bindings.to_vec(),
-            push_constant_size: desc.push_constant_size,
-            stages,
-            name,
-        })
+        let raw = unsafe { ctx.device().create_graphics_pipelines(vk::PipelineCache::null(), &info, None) }
+            .map_err(|(_, e)| runtime!("graphics pipeline {name}: {e}"))?[0];
+        Ok(layouts.into_pipeline(ctx, raw, vk::PipelineBindPoint::GRAPHICS, name))
     }
 }
 
-/// Fixed-function state of a graphics pipeline that draws into dynamic-rendering attachments.
+/// Shaders and fixed-function state of a graphics pipeline that draws into dynamic-rendering
+/// attachments. Its layout is what the shaders declare.
 pub struct GraphicsDesc<'a> {
     pub vertex_shader: &'a str,
     /// `None` for depth-only passes (shadow maps).
@@ -341,6 +449,4 @@ pub struct GraphicsDesc<'a> {
     pub additive_blend: bool,
     /// Values of the shaders' specialisation constants, by constant_id (0, 1, ...).
     pub specialization: &'a [u32],
-    pub bindings: &'a [BindingKind],
-    pub push_constant_size: u32,
 }

@@ -174,7 +174,7 @@ impl Presenter {
         let device = &self.shared.device;
         // SAFETY: valid device; the objects are destroyed in Drop.
         unsafe {
-            let (pool, cmd) = super::commands::command_pool_with_one_buffer(device, queue_family)?;
+            let (pool, cmd) = super::submit::command_pool_with_one_buffer(device, queue_family)?;
             // Signalled, so that the first wait on an unused slot returns at once.
             let fence = device
                 .create_fence(&vk::FenceCreateInfo::default().flags(vk::FenceCreateFlags::SIGNALED), None)
