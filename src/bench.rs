@@ -9,13 +9,14 @@
 use glam::Vec3;
 
 use crate::error::Result;
-use crate::frame::{FrameOptions, Renderer, Show, SubsurfaceOptions, DEFAULT_EPSILON};
-use crate::hierarchy::{self, HierarchyOptions};
+use crate::frame::{Renderer, DEFAULT_EPSILON};
+use crate::hierarchy;
 use crate::mesh::Mesh;
-use crate::output::{Exposure, HdrImage};
+use crate::output::HdrImage;
 use crate::passes::shade::WorkCounters;
 use crate::profiling::{summary, PassStats, ProfileReport, Scope};
 use crate::scene::{bounding_sphere, Camera, Light, Scene};
+use crate::settings::RenderSettings;
 use crate::vk::{Context, ContextOptions};
 
 pub struct BenchOptions {
@@ -127,26 +128,13 @@ fn run_with(
     specular: bool,
 ) -> Result<Run> {
     let ctx = Context::new(context)?;
-    hierarchy::check_point_count(&ctx, n, scene.lights.len() as u32)?;
     let device = format!("{} ({})", ctx.info.name, ctx.info.driver);
-    let options = FrameOptions {
-        subsurface: SubsurfaceOptions {
-            material: material.clone(),
-            model,
-            diffusion: crate::physics::Diffusion::Classical,
-            epsilon,
-            brute_force,
-            specular,
-            roughness: 0.35,
-        },
-        width: size.0,
-        height: size.1,
-        profile: true,
-        count_work: true,
-        hierarchy: HierarchyOptions { point_count: n, shadow_resolution: 1024, eta: 1.5 },
-        show: Show::Shading,
-        exposure: Exposure::Auto,
-    };
+    let mut settings = RenderSettings::new(scene.clone(), material.clone());
+    settings.subsurface.model = model;
+    (settings.subsurface.epsilon, settings.subsurface.brute_force, settings.subsurface.specular) =
+        (epsilon, brute_force, specular);
+    (settings.width, settings.height, settings.samples, settings.count_work) = (size.0, size.1, Some(n), true);
+    let options = settings.frame_options(settings.point_count(&ctx)?);
     let mut renderer = Renderer::new(ctx, scene, options)?;
     let mut timed = Vec::new();
     for _ in 0..frames.max(2) {
