@@ -213,9 +213,7 @@ impl Renderer {
         if !(subsurface.epsilon.is_finite() && subsurface.epsilon >= 0.0) {
             return Err(bad_input!("--epsilon {}: must be a finite number ≥ 0", subsurface.epsilon));
         }
-        if !(subsurface.roughness > 0.0 && subsurface.roughness <= 1.0) {
-            return Err(bad_input!("--roughness {}: must be in (0, 1]", subsurface.roughness));
-        }
+        crate::settings::check_roughness(subsurface.roughness, "--roughness")?;
         let max = ctx.limits().max_image_dimension2_d;
         if width == 0 || height == 0 || width > max || height > max {
             return Err(bad_input!(
@@ -347,9 +345,7 @@ impl Renderer {
         if !(subsurface.epsilon.is_finite() && subsurface.epsilon >= 0.0) {
             return Err(bad_input!("epsilon {}: must be a finite number ≥ 0", subsurface.epsilon));
         }
-        if !(subsurface.roughness > 0.0 && subsurface.roughness <= 1.0) {
-            return Err(bad_input!("roughness {}: must be in (0, 1]", subsurface.roughness));
-        }
+        crate::settings::check_roughness(subsurface.roughness, "roughness")?;
         let count_work = self.subsurface_params.read::<SubsurfaceParams>(1)?[0].count_work;
         let mut params = subsurface_params(subsurface, mm_per_unit, self.hierarchy.point_count);
         params.count_work = count_work;
