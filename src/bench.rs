@@ -13,7 +13,7 @@ use crate::frame::{Renderer, DEFAULT_EPSILON};
 use crate::hierarchy;
 use crate::mesh::Mesh;
 use crate::output::HdrImage;
-use crate::passes::shade::WorkCounters;
+use crate::gpu::WorkCounters;
 use crate::profiling::{summary, PassStats, ProfileReport, Scope};
 use crate::scene::{bounding_sphere, Camera, Light, Scene};
 use crate::settings::RenderSettings;

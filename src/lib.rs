@@ -9,6 +9,7 @@ pub mod commands;
 pub mod deform;
 pub mod error;
 pub mod frame;
+pub mod gpu;
 pub mod hierarchy;
 pub mod materials;
 pub mod mesh;

@@ -144,10 +144,10 @@ impl SceneSettings {
                 }
             }
         }
-        if lights.len() > crate::passes::irradiance::MAX_LIGHTS {
+        if lights.len() > crate::gpu::MAX_LIGHTS {
             return Err(bad_input!(
                 "--light: at most {} lights, {} given",
-                crate::passes::irradiance::MAX_LIGHTS,
+                crate::gpu::MAX_LIGHTS,
                 lights.len()
             ));
         }
