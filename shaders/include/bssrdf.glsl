@@ -1,6 +1,6 @@
 // The BSSRDF in f32, mirroring src/physics/ (f64): exact Fresnel, the classical dipole
 // (Jensen et al. 2001) and the directional dipole (Frisvad et al. 2014). Material constants come
-// precomputed in f64 on the CPU (BssrdfChannel = GpuChannel in src/physics/mod.rs): the 3C2
+// precomputed in f64 on the CPU (BssrdfChannel = GpuChannel in src/gpu/subsurface.rs): the 3C2
 // polynomial behind CE cancels from ~1600 to ~0.4 and must not be evaluated in f32.
 // Conventions: normals outward, wi from the surface toward the light, eta = n_inside/n_outside.
 #ifndef BSSRDF_GLSL
