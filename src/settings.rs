@@ -40,7 +40,7 @@ pub fn check_roughness(roughness: f32, what: &str) -> Result<()> {
 }
 
 /// The scene's inputs: a mesh, the camera and the lights, with the command line's defaults.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct SceneSettings {
     /// `sphere`, `box`, `slab`, `torus` or an OBJ path (`None`: the bunny when installed, else the
     /// sphere); `{frame}` names a sequence, whose first file is the scene's mesh.

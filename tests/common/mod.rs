@@ -5,7 +5,13 @@ use std::path::PathBuf;
 use std::process::{Command, Output};
 use std::sync::Arc;
 
+use glam::Vec3;
+use translucent::frame::Renderer;
+use translucent::mesh::safe_normalize;
+use translucent::output::HdrImage;
 use translucent::physics::{Medium, Query};
+use translucent::scene::Light;
+use translucent::settings::RenderSettings;
 use translucent::vk::{Context, ContextOptions, ValidationCounts};
 
 /// A context with validation and synchronization validation on. The counts are returned separately
@@ -21,6 +27,39 @@ pub fn assert_clean(counts: &ValidationCounts) {
     use std::sync::atomic::Ordering;
     let (w, e) = (counts.warnings.load(Ordering::SeqCst), counts.errors.load(Ordering::SeqCst));
     assert_eq!((w, e), (0, 0), "validation reported {e} error(s) and {w} warning(s); see the log above");
+}
+
+/// Renders one frame of `settings` through the library, as `translucent render --validation` does,
+/// on a context with validation and synchronization validation (any message fails the test).
+/// Returns the renderer, for the image, the tone-mapped image or the work counters; the caller
+/// drops it and then calls [`assert_clean`] on the counts.
+pub fn render_frame(settings: &RenderSettings) -> (Renderer, Arc<ValidationCounts>) {
+    let (ctx, counts) = validated_context();
+    let point_count = settings.point_count(&ctx).expect("sample count");
+    let mut renderer = Renderer::new(ctx, &settings.scene, settings.frame_options(point_count)).expect("renderer");
+    renderer.render_frame(&settings.scene).expect("frame");
+    (renderer, counts)
+}
+
+/// One frame of `settings` (see [`render_frame`]): its linear radiance, validation checked clean.
+pub fn render_hdr(settings: &RenderSettings) -> HdrImage {
+    let (renderer, counts) = render_frame(settings);
+    let image = renderer.image().expect("image");
+    drop(renderer);
+    assert_clean(&counts);
+    image
+}
+
+/// A directional light toward `toward` (normalised as `--light dir:X,Y,Z:I` does) with
+/// irradiance `irradiance` at normal incidence.
+pub fn dir_light(toward: [f32; 3], irradiance: [f32; 3]) -> Light {
+    let toward = safe_normalize(Vec3::from(toward)).expect("a light direction");
+    Light::Directional { toward, irradiance: Vec3::from(irradiance) }
+}
+
+/// A point light at `position` with radiant intensity `intensity` (`--light point:X,Y,Z:I`).
+pub fn point_light(position: [f32; 3], intensity: [f32; 3]) -> Light {
+    Light::Point { position: Vec3::from(position), intensity: Vec3::from(intensity) }
 }
 
 /// Runs the `translucent` binary with `args`.
