@@ -6,12 +6,9 @@ use std::path::PathBuf;
 use clap::{Args, Parser, Subcommand};
 use glam::Vec3;
 
-use crate::error::Result;
-use crate::materials::Material;
 use crate::mesh::safe_normalize;
 use crate::physics::{Diffusion, Model};
 use crate::scene::Light;
-use crate::vk::ContextOptions;
 
 #[derive(Parser, Debug)]
 #[command(name = "translucent", version, about = "Subsurface scattering with the directional dipole on Vulkan")]
@@ -142,25 +139,6 @@ pub struct MaterialArgs {
     pub eta: Option<f64>,
 }
 
-impl MaterialArgs {
-    pub fn material(&self) -> Result<Material> {
-        let mut m = Material::find(&self.material)?;
-        let custom = self.sigma_a.is_some() || self.sigma_s.is_some() || self.g.is_some() || self.eta.is_some();
-        m.sigma_a = self.sigma_a.unwrap_or(m.sigma_a);
-        m.sigma_s = self.sigma_s.unwrap_or(m.sigma_s);
-        m.g = self.g.unwrap_or(m.g);
-        m.eta = self.eta.unwrap_or(m.eta);
-        if custom {
-            m.name = format!("{} (modified)", m.name);
-        }
-        m.validate()?;
-        if let Some(w) = m.warning() {
-            crate::note!("warning: {w}");
-        }
-        Ok(m)
-    }
-}
-
 #[derive(Args, Debug)]
 pub struct ProfileArgs {
     #[command(flatten)]
@@ -197,13 +175,6 @@ pub struct DeviceArgs {
     /// makes the exit code non-zero. Also enabled by TRANSLUCENT_VALIDATION=1.
     #[arg(long)]
     pub validation: bool,
-}
-
-impl DeviceArgs {
-    pub fn options(&self) -> ContextOptions {
-        let from_env = std::env::var("TRANSLUCENT_VALIDATION").map(|v| v != "0" && !v.is_empty()).unwrap_or(false);
-        ContextOptions { validation: self.validation || from_env, device: self.device.clone() }
-    }
 }
 
 #[derive(Args, Debug)]

@@ -6,7 +6,7 @@
 use glam::Vec3;
 
 use crate::bad_input;
-use crate::cli::{RenderArgs, ShowArg};
+use crate::cli::{DeviceArgs, MaterialArgs, RenderArgs, ShowArg};
 use crate::error::Result;
 use crate::frame::{FrameOptions, Show, SubsurfaceOptions, DEFAULT_EPSILON};
 use crate::hierarchy::HierarchyOptions;
@@ -15,7 +15,7 @@ use crate::mesh::safe_normalize;
 use crate::output::Exposure;
 use crate::physics::{Diffusion, Model};
 use crate::scene::{Camera, Light, Scene};
-use crate::vk::Context;
+use crate::vk::{Context, ContextOptions};
 
 /// The sizes (mm across) a mesh may have once --scale is applied: from a micrometre to a thousand
 /// kilometres, so that areas in mm² and the powers summed over them stay finite in f32.
@@ -37,6 +37,34 @@ pub fn check_roughness(roughness: f32, what: &str) -> Result<()> {
         return Err(bad_input!("{what} {roughness}: must be in (0, 1]"));
     }
     Ok(())
+}
+
+impl MaterialArgs {
+    /// The preset with the coefficients given overridden, validated; prints the material's warning.
+    pub fn material(&self) -> Result<Material> {
+        let mut m = Material::find(&self.material)?;
+        let custom = self.sigma_a.is_some() || self.sigma_s.is_some() || self.g.is_some() || self.eta.is_some();
+        m.sigma_a = self.sigma_a.unwrap_or(m.sigma_a);
+        m.sigma_s = self.sigma_s.unwrap_or(m.sigma_s);
+        m.g = self.g.unwrap_or(m.g);
+        m.eta = self.eta.unwrap_or(m.eta);
+        if custom {
+            m.name = format!("{} (modified)", m.name);
+        }
+        m.validate()?;
+        if let Some(w) = m.warning() {
+            crate::note!("warning: {w}");
+        }
+        Ok(m)
+    }
+}
+
+impl DeviceArgs {
+    /// The device and validation asked for, by flag or by TRANSLUCENT_VALIDATION.
+    pub fn options(&self) -> ContextOptions {
+        let from_env = std::env::var("TRANSLUCENT_VALIDATION").map(|v| v != "0" && !v.is_empty()).unwrap_or(false);
+        ContextOptions { validation: self.validation || from_env, device: self.device.clone() }
+    }
 }
 
 /// The scene's inputs: a mesh, the camera and the lights, with the command line's defaults.
