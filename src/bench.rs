@@ -10,10 +10,10 @@ use glam::Vec3;
 
 use crate::error::Result;
 use crate::frame::{Renderer, DEFAULT_EPSILON};
+use crate::gpu::WorkCounters;
 use crate::hierarchy;
 use crate::mesh::Mesh;
 use crate::output::{relative_rmse, HdrImage};
-use crate::gpu::WorkCounters;
 use crate::profiling::{summary, PassStats, ProfileReport, Scope};
 use crate::scene::{bounding_sphere, Camera, Light, Scene};
 use crate::settings::RenderSettings;

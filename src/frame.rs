@@ -4,10 +4,10 @@ use glam::Vec3;
 
 use crate::bad_input;
 use crate::error::Result;
+use crate::gpu::{DebugConstants, GpuChannel, ShadeConstants, SubsurfaceParams, WorkCounters};
 use crate::hierarchy::{Hierarchy, HierarchyOptions};
 use crate::materials::Material;
 use crate::output::{self, Exposure, HdrImage};
-use crate::gpu::{DebugConstants, GpuChannel, ShadeConstants, SubsurfaceParams, WorkCounters};
 use crate::passes::debug_view::{self, DebugViewPass};
 use crate::passes::shade::{self, ShadeInputs, ShadePass};
 use crate::passes::tonemap::{self, TonemapPass};

@@ -10,8 +10,10 @@
 use glam::{DVec3, Mat4, Vec3};
 
 use crate::error::Result;
+use crate::gpu::{
+    GpuLight, LightSetHeader, NodeLight, PointLight, SurfacePoint, TreeNode, LEAF_BIT, MAX_LIGHTS, RADIX_TILE as TILE,
+};
 use crate::mesh::Mesh;
-use crate::gpu::{GpuLight, LightSetHeader, NodeLight, PointLight, SurfacePoint, TreeNode, LEAF_BIT, MAX_LIGHTS, RADIX_TILE as TILE};
 use crate::passes::irradiance::IrradiancePass;
 use crate::passes::sampling::SamplingPass;
 use crate::passes::shadow::{self, ShadowPass};

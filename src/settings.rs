@@ -146,7 +146,8 @@ impl SceneSettings {
         let mut camera = Camera::framing(centre, radius, self.fov, Vec3::new(0.3, 0.3, 1.0));
         // Directions are normalised here, safely: (1e20, 1e20, 0) is a fine direction whose squared
         // length overflows f32, and would otherwise turn into NaN on the GPU.
-        camera.up = safe_normalize(self.up).ok_or_else(|| bad_input!("--up {}: must be finite and non-zero", self.up))?;
+        camera.up =
+            safe_normalize(self.up).ok_or_else(|| bad_input!("--up {}: must be finite and non-zero", self.up))?;
         for (flag, p) in [("--eye", self.eye), ("--target", self.target)] {
             if let Some(p) = p.filter(|p| p.abs().max_element() > MAX_COORDINATE) {
                 return Err(bad_input!("{flag} {p}: coordinates must be within ±{MAX_COORDINATE:e}"));
@@ -159,8 +160,9 @@ impl SceneSettings {
             camera.eye = eye;
         }
         let lights = if self.lights.is_empty() {
-            let toward = safe_normalize(self.light_dir)
-                .ok_or_else(|| bad_input!("--light-dir {}: light direction must be finite and non-zero", self.light_dir))?;
+            let toward = safe_normalize(self.light_dir).ok_or_else(|| {
+                bad_input!("--light-dir {}: light direction must be finite and non-zero", self.light_dir)
+            })?;
             vec![Light::Directional { toward, irradiance: self.light_intensity }]
         } else {
             self.lights.clone()
@@ -173,11 +175,7 @@ impl SceneSettings {
             }
         }
         if lights.len() > crate::gpu::MAX_LIGHTS {
-            return Err(bad_input!(
-                "--light: at most {} lights, {} given",
-                crate::gpu::MAX_LIGHTS,
-                lights.len()
-            ));
+            return Err(bad_input!("--light: at most {} lights, {} given", crate::gpu::MAX_LIGHTS, lights.len()));
         }
         let scene = Scene { mesh, camera, lights, mm_per_unit: self.scale };
         scene.validate()?;

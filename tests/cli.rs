@@ -252,9 +252,15 @@ fn render_flags_default_to_the_library_settings() {
     let code = RenderSettings::new(scene.build().unwrap(), translucent::materials::Material::find("marble").unwrap());
     let (a, b) = (&flags.subsurface, &code.subsurface);
     assert_eq!((&a.material, a.model, a.diffusion), (&b.material, b.model, b.diffusion));
-    assert_eq!((a.epsilon, a.brute_force, a.specular, a.roughness), (b.epsilon, b.brute_force, b.specular, b.roughness));
+    assert_eq!(
+        (a.epsilon, a.brute_force, a.specular, a.roughness),
+        (b.epsilon, b.brute_force, b.specular, b.roughness)
+    );
     assert_eq!((flags.width, flags.height, flags.samples), (code.width, code.height, code.samples));
-    assert_eq!((flags.shadow_resolution, flags.show, flags.exposure), (code.shadow_resolution, code.show, code.exposure));
+    assert_eq!(
+        (flags.shadow_resolution, flags.show, flags.exposure),
+        (code.shadow_resolution, code.show, code.exposure)
+    );
     assert_eq!((flags.profile, flags.count_work), (code.profile, code.count_work));
 }
 
@@ -281,6 +287,7 @@ fn render_writes_the_library_frame() {
     (s.subsurface.model, s.subsurface.epsilon) = (translucent::physics::Model::Dipole, 0.1);
     let library = common::render_hdr(&s);
     assert_eq!((cli.width(), cli.height()), (library.width, library.height));
-    let differing = cli.pixels().zip(&library.pixels).filter(|(p, q)| p.0.map(f32::to_bits) != q.map(f32::to_bits)).count();
+    let differing =
+        cli.pixels().zip(&library.pixels).filter(|(p, q)| p.0.map(f32::to_bits) != q.map(f32::to_bits)).count();
     assert_eq!(differing, 0, "pixels differing between the binary and the library");
 }

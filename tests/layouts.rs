@@ -144,13 +144,26 @@ fn tonemap_structs_match_glsl() {
 #[test]
 fn push_constants_match_glsl() {
     use translucent::gpu::{DebugConstants, EvalConstants, MortonConstants, RadixConstants, SampleConstants};
-    let offsets = |shader: &str, block: &str| member_offsets(shader, block).unwrap_or_else(|| panic!("{block} in {shader}"));
-    assert_eq!(offsets("bssrdf_eval.comp", "EvalConstants"), [offset_of!(EvalConstants, count), offset_of!(EvalConstants, model)].map(|o| o as u32));
-    let sample = [offset_of!(SampleConstants, point_count), offset_of!(SampleConstants, triangle_count), offset_of!(SampleConstants, seed)];
+    let offsets =
+        |shader: &str, block: &str| member_offsets(shader, block).unwrap_or_else(|| panic!("{block} in {shader}"));
+    assert_eq!(
+        offsets("bssrdf_eval.comp", "EvalConstants"),
+        [offset_of!(EvalConstants, count), offset_of!(EvalConstants, model)].map(|o| o as u32)
+    );
+    let sample = [
+        offset_of!(SampleConstants, point_count),
+        offset_of!(SampleConstants, triangle_count),
+        offset_of!(SampleConstants, seed),
+    ];
     assert_eq!(offsets("hierarchy/sample_points.comp", "SampleConstants"), sample.map(|o| o as u32));
-    let morton = [offset_of!(MortonConstants, bounds_min), offset_of!(MortonConstants, bounds_extent), offset_of!(MortonConstants, point_count)];
+    let morton = [
+        offset_of!(MortonConstants, bounds_min),
+        offset_of!(MortonConstants, bounds_extent),
+        offset_of!(MortonConstants, point_count),
+    ];
     assert_eq!(offsets("hierarchy/morton.comp", "MortonConstants"), morton.map(|o| o as u32));
-    let radix = [offset_of!(RadixConstants, count), offset_of!(RadixConstants, tile_count), offset_of!(RadixConstants, shift)];
+    let radix =
+        [offset_of!(RadixConstants, count), offset_of!(RadixConstants, tile_count), offset_of!(RadixConstants, shift)];
     for shader in ["hierarchy/radix_histogram.comp", "hierarchy/radix_scan.comp", "hierarchy/radix_scatter.comp"] {
         let glsl = offsets(shader, "RadixConstants");
         assert_eq!(glsl, radix.map(|o| o as u32), "{shader}");

@@ -50,10 +50,7 @@ impl BssrdfEvalPass {
                 BufferUsageFlags::STORAGE_BUFFER,
                 MemoryLocation::GpuToCpu,
             )?;
-            let constants = EvalConstants {
-                count: rows.len() as u32,
-                model: model.gpu_code(),
-            };
+            let constants = EvalConstants { count: rows.len() as u32, model: model.gpu_code() };
             let groups = rows.len().div_ceil(GROUP) as u32;
             ctx.submit(None, |rec| {
                 rec.dispatch(

@@ -2,7 +2,6 @@
 //! Reads: lights, shadow map. Writes: points (irradiance, mean light direction), each light's
 //! record of each point.
 
-
 use crate::error::Result;
 use crate::vk::{Bind, BindingKind, Buffer, Context, Image, Pipeline, Recorder, Sampler};
 

@@ -1,7 +1,6 @@
 //! Surface sampling: the triangle-area prefix sum (64-bit fixed point), then N points uniform by area.
 //! Reads: vertices, indices. Writes: area prefix sum, points (unsorted).
 
-
 use crate::error::Result;
 use crate::gpu::SampleConstants;
 use crate::vk::{Bind, BindingKind, Buffer, Context, Pipeline, Recorder};

@@ -2,7 +2,6 @@
 //! coverage, auto exposure from a luminance histogram without reading anything back.
 //! Reads: the HDR colour image (storage, rgba32f). Writes: the histogram and the packed RGBA8 buffer.
 
-
 use crate::error::Result;
 use crate::gpu::{HistogramTables, TonemapConstants, HISTOGRAM_HEADER_BYTES};
 use crate::output::{Exposure, HIST_BINS};

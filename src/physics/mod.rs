@@ -9,7 +9,6 @@ pub mod dirpole;
 pub mod fresnel;
 pub mod microfacet;
 
-
 /// Which diffusion coefficient the directional dipole uses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Diffusion {

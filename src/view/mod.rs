@@ -453,8 +453,13 @@ impl Viewer {
         }
         let (centre, _) = crate::scene::bounding_sphere(&scene.mesh.positions);
         let device_label = device_name.clone();
-        let animation =
-            crate::deform::Animation::new(&SceneSettings::from_args(r).mesh_spec(), &scene.mesh, r.deform, r.deform_period, r.up)?;
+        let animation = crate::deform::Animation::new(
+            &SceneSettings::from_args(r).mesh_spec(),
+            &scene.mesh,
+            r.deform,
+            r.deform_period,
+            r.up,
+        )?;
         let ui = if args.no_panel {
             None
         } else {
