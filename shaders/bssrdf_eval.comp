@@ -1,10 +1,11 @@
 #version 460
 // Evaluates Sd for a list of queries (the `bssrdf --gpu` command and the GPU-vs-CPU tests).
 #include "bssrdf.glsl"
+#include "gpu_constants.glsl"
 
 layout(local_size_x = 64) in;
 
-// Mirrors BssrdfQueryGpu in src/passes/bssrdf_eval.rs.
+// Mirrors BssrdfQueryGpu in src/gpu/passes.rs.
 struct BssrdfQuery {
     BssrdfChannel channel;
     vec4 xi;
@@ -27,7 +28,7 @@ void main() {
     if (i >= pc.count) return;
     BssrdfQuery q = queries[i];
     float value;
-    if (pc.model == 0u) {
+    if (pc.model == MODEL_DIRECTIONAL) {
         value = dirpole_sd(q.channel, q.xi.xyz, q.ni.xyz, q.wi.xyz, q.xo.xyz, q.no.xyz);
     } else {
         value = dipole_sd(q.channel, length(q.xo.xyz - q.xi.xyz));

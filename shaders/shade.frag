@@ -58,7 +58,7 @@ vec3 source(vec3 xi, vec3 ni, vec3 wi, vec3 power, vec3 xo, vec3 no) {
     float s = params.mm_per_unit;
     vec3 sd;
     // Written out, not looped: loop iterations count against llvmpipe's budget (see main).
-    if (MODEL == 0u) {
+    if (MODEL == MODEL_DIRECTIONAL) {
         // The geometry once for all three channels (they share eta).
         vec3 xi_mm = xi * s, xo_mm = xo * s;
         DirpoleGeometry g = dirpole_geometry(xi_mm, ni, wi, xo_mm, no, params.channels[0].eta);

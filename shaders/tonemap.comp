@@ -10,7 +10,7 @@
 layout(local_size_x = 16, local_size_y = 16) in;
 
 layout(binding = 0, rgba32f) uniform readonly image2D hdr;
-// Mirrors `HistogramTables` in src/passes/tonemap.rs (checked by tests/layouts.rs).
+// Mirrors `HistogramTables` in src/gpu/passes.rs (checked by tests/layouts.rs).
 layout(std430, binding = 1) readonly buffer HistogramTables {
     float thresholds[16];   // lower bin edges within a stop, 2^(j/16)
     float inv_centres[16];  // 2^(-(j+0.5)/16)

@@ -9,13 +9,14 @@
 use glam::Vec3;
 
 use crate::error::Result;
-use crate::frame::{FrameOptions, Renderer, Show, SubsurfaceOptions, DEFAULT_EPSILON};
-use crate::hierarchy::{self, HierarchyOptions};
+use crate::frame::{Renderer, DEFAULT_EPSILON};
+use crate::gpu::WorkCounters;
+use crate::hierarchy;
 use crate::mesh::Mesh;
-use crate::output::{Exposure, HdrImage};
-use crate::passes::shade::WorkCounters;
+use crate::output::{relative_rmse, HdrImage};
 use crate::profiling::{summary, PassStats, ProfileReport, Scope};
 use crate::scene::{bounding_sphere, Camera, Light, Scene};
+use crate::settings::RenderSettings;
 use crate::vk::{Context, ContextOptions};
 
 pub struct BenchOptions {
@@ -76,7 +77,7 @@ fn peer_comparison(options: &BenchOptions) -> Result<String> {
         rate / pbrt_rate,
         per_pixel(run.work.node_sum),
         per_pixel(run.work.evaluation_sum),
-        100.0 * relative_rmse(&tree.image, &brute.image)
+        100.0 * relative_rmse(&tree.image.pixels, &brute.image.pixels)
     ))
 }
 
@@ -127,26 +128,13 @@ fn run_with(
     specular: bool,
 ) -> Result<Run> {
     let ctx = Context::new(context)?;
-    hierarchy::check_point_count(&ctx, n, scene.lights.len() as u32)?;
     let device = format!("{} ({})", ctx.info.name, ctx.info.driver);
-    let options = FrameOptions {
-        subsurface: SubsurfaceOptions {
-            material: material.clone(),
-            model,
-            diffusion: crate::physics::Diffusion::Classical,
-            epsilon,
-            brute_force,
-            specular,
-            roughness: 0.35,
-        },
-        width: size.0,
-        height: size.1,
-        profile: true,
-        count_work: true,
-        hierarchy: HierarchyOptions { point_count: n, shadow_resolution: 1024, eta: 1.5 },
-        show: Show::Shading,
-        exposure: Exposure::Auto,
-    };
+    let mut settings = RenderSettings::new(scene.clone(), material.clone());
+    settings.subsurface.model = model;
+    (settings.subsurface.epsilon, settings.subsurface.brute_force, settings.subsurface.specular) =
+        (epsilon, brute_force, specular);
+    (settings.width, settings.height, settings.samples, settings.count_work) = (size.0, size.1, Some(n), true);
+    let options = settings.frame_options(settings.point_count(&ctx)?);
     let mut renderer = Renderer::new(ctx, scene, options)?;
     let mut timed = Vec::new();
     for _ in 0..frames.max(2) {
@@ -161,24 +149,6 @@ fn run_with(
 
 fn pass_ms(run: &Run, name: &str) -> f64 {
     run.passes.iter().find(|p| p.name == name).map(|p| p.mean_ms).unwrap_or(0.0)
-}
-
-/// sqrt(Σ(a − b)² / Σ b²) over covered pixels and all channels.
-pub fn relative_rmse(a: &HdrImage, b: &HdrImage) -> f64 {
-    let (mut num, mut den) = (0.0f64, 0.0f64);
-    for (p, q) in a.pixels.iter().zip(&b.pixels) {
-        if q[3] > 0.0 {
-            for c in 0..3 {
-                num += (p[c] as f64 - q[c] as f64).powi(2);
-                den += (q[c] as f64).powi(2);
-            }
-        }
-    }
-    if den > 0.0 {
-        (num / den).sqrt()
-    } else {
-        0.0
-    }
 }
 
 /// Peak resident memory of this process (VmHWM) in MiB; on lavapipe GPU memory is host memory.
@@ -284,7 +254,7 @@ pub fn run(options: &BenchOptions) -> Result<String> {
             per_pixel(&brute.work, brute.work.evaluation_sum),
             tree_evaluations,
             per_pixel(&tree.work, tree.work.node_sum),
-            100.0 * relative_rmse(&tree.image, &brute.image)
+            100.0 * relative_rmse(&tree.image.pixels, &brute.image.pixels)
         );
         crate::note!("bench: brute force N={n} done");
         if sweep_reference.is_none() {
@@ -306,7 +276,7 @@ pub fn run(options: &BenchOptions) -> Result<String> {
                 per_pixel(&tree.work, tree.work.node_sum),
                 per_pixel(&tree.work, tree.work.point_sum),
                 per_pixel(&tree.work, tree.work.evaluation_sum),
-                100.0 * relative_rmse(&tree.image, &brute.image)
+                100.0 * relative_rmse(&tree.image.pixels, &brute.image.pixels)
             );
             crate::note!("bench: epsilon {eps} done");
         }

@@ -4,15 +4,16 @@ use glam::Vec3;
 
 use crate::bad_input;
 use crate::error::Result;
+use crate::gpu::{DebugConstants, GpuChannel, ShadeConstants, SubsurfaceParams, WorkCounters};
 use crate::hierarchy::{Hierarchy, HierarchyOptions};
 use crate::materials::Material;
 use crate::output::{self, Exposure, HdrImage};
-use crate::passes::debug_view::{self, DebugConstants, DebugViewPass};
-use crate::passes::shade::{self, ShadeConstants, ShadeInputs, ShadePass, SubsurfaceParams, WorkCounters};
+use crate::passes::debug_view::{self, DebugViewPass};
+use crate::passes::shade::{self, ShadeInputs, ShadePass};
 use crate::passes::tile_cut::{TileCutPass, TileLists};
 use crate::passes::tonemap::{self, TonemapPass};
 use crate::physics::dipole::{self, SdTable};
-use crate::physics::{Diffusion, GpuChannel, Model};
+use crate::physics::{Diffusion, Model};
 use crate::scene::Scene;
 use crate::vk::{
     self, Buffer, BufferUsageFlags, Context, Extent2D, GpuProfiler, Image, ImageUsageFlags, MemoryLocation, TimedScope,
@@ -48,10 +49,7 @@ fn subsurface_params(o: &SubsurfaceOptions, mm_per_unit: f32, point_count: u32) 
         channels: [channel(0), channel(1), channel(2)],
         mm_per_unit,
         epsilon: o.epsilon,
-        model: match o.model {
-            Model::Directional => 0,
-            Model::Dipole => 1,
-        },
+        model: o.model.gpu_code(),
         brute_force: o.brute_force as u32,
         point_count,
         node_count: point_count - 1,
@@ -245,9 +243,7 @@ impl Renderer {
         if !(subsurface.epsilon.is_finite() && subsurface.epsilon >= 0.0) {
             return Err(bad_input!("--epsilon {}: must be a finite number ≥ 0", subsurface.epsilon));
         }
-        if !(subsurface.roughness > 0.0 && subsurface.roughness <= 1.0) {
-            return Err(bad_input!("--roughness {}: must be in (0, 1]", subsurface.roughness));
-        }
+        crate::settings::check_roughness(subsurface.roughness, "--roughness")?;
         let max = ctx.limits().max_image_dimension2_d;
         if width == 0 || height == 0 || width > max || height > max {
             return Err(bad_input!(
@@ -397,9 +393,7 @@ impl Renderer {
         if !(subsurface.epsilon.is_finite() && subsurface.epsilon >= 0.0) {
             return Err(bad_input!("epsilon {}: must be a finite number ≥ 0", subsurface.epsilon));
         }
-        if !(subsurface.roughness > 0.0 && subsurface.roughness <= 1.0) {
-            return Err(bad_input!("roughness {}: must be in (0, 1]", subsurface.roughness));
-        }
+        crate::settings::check_roughness(subsurface.roughness, "roughness")?;
         let count_work = self.subsurface_params.read::<SubsurfaceParams>(1)?[0].count_work;
         let mut params = subsurface_params(subsurface, mm_per_unit, self.hierarchy.point_count);
         params.count_work = count_work;
@@ -718,7 +712,7 @@ impl Renderer {
         let Err(e) = output::check_finite(&self.image()?) else { return Ok(()) };
         if std::env::var("TRANSLUCENT_CHECK_PASSES").is_ok_and(|v| !v.is_empty() && v != "0") {
             let snapshot = self.hierarchy.download(&self.ctx)?;
-            let bad_point = |p: &crate::hierarchy::SurfacePoint| !(p.position.is_finite() && p.area.is_finite());
+            let bad_point = |p: &crate::gpu::SurfacePoint| !(p.position.is_finite() && p.area.is_finite());
             let pass = if snapshot.points.iter().any(bad_point) || snapshot.points.iter().any(|p| !p.normal.is_finite())
             {
                 "sampling"

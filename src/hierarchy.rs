@@ -7,72 +7,23 @@
 //! contiguous range of the sorted array. Leaves are single points; the shading pass can stop
 //! descending at small ranges and loop over the points directly.
 
-use bytemuck::{Pod, Zeroable};
 use glam::{DVec3, Mat4, Vec3};
 
 use crate::error::Result;
+use crate::gpu::{
+    GpuLight, LightSetHeader, NodeLight, PointLight, SurfacePoint, TreeNode, LEAF_BIT, MAX_LIGHTS, RADIX_TILE as TILE,
+};
 use crate::mesh::Mesh;
-use crate::passes::irradiance::{GpuLight, IrradiancePass, LightSetHeader, MAX_LIGHTS};
+use crate::passes::irradiance::IrradiancePass;
 use crate::passes::sampling::SamplingPass;
 use crate::passes::shadow::{self, ShadowPass};
-use crate::passes::sort::{SortBuffers, SortPass, TILE};
+use crate::passes::sort::{SortBuffers, SortPass};
 use crate::passes::tree::{TreeBuffers, TreePass};
 use crate::scene::Light;
 use crate::vk::{
     self, Buffer, BufferUsageFlags, Context, Extent2D, Image, ImageUsageFlags, MemoryLocation, Recorder, Sampler,
 };
 use crate::{bad_input, runtime};
-
-/// Mirrors `SurfacePoint` in shaders/include/points.glsl (64 bytes).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
-pub struct SurfacePoint {
-    pub position: Vec3,
-    pub area: f32,
-    pub normal: Vec3,
-    pub triangle: u32,
-    pub irradiance: Vec3,
-    pub pad0: f32,
-    pub light_dir: Vec3,
-    pub pad1: f32,
-}
-
-/// Mirrors `PointLight` in shaders/include/points.glsl (16 bytes): one light at one point.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
-pub struct PointLight {
-    pub irradiance: Vec3,
-    pub toward_oct: u32,
-}
-
-/// Mirrors `NodeLight` in shaders/include/points.glsl (32 bytes): one light over one node.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
-pub struct NodeLight {
-    pub power: Vec3,
-    pub toward_oct: u32,
-    pub power_center: Vec3,
-    pub spread2: f32,
-}
-
-/// Set in a child index when the child is a point (index into the sorted points).
-pub const LEAF_BIT: u32 = 0x8000_0000;
-
-/// Mirrors `TreeNode` in shaders/include/points.glsl (64 bytes).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
-pub struct TreeNode {
-    pub power: Vec3,
-    pub area: f32,
-    pub center: Vec3,
-    pub left: u32,
-    pub box_half: [u32; 3],
-    pub right: u32,
-    pub normal_oct: u32,
-    pub light_oct: u32,
-    pub first_point: u32,
-    pub point_count: u32,
-}
 
 impl TreeNode {
     /// The bounding box (min, max) from its half floats.

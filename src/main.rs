@@ -6,7 +6,7 @@ fn main() {
         Ok(cli) => cli,
         Err(e) => std::process::exit(translucent::cli::usage_exit(e)),
     };
-    let code = match translucent::cli::run(cli) {
+    let code = match translucent::commands::run(cli) {
         Ok(code) => code,
         Err(e) => {
             translucent::note!("error: {e}");

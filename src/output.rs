@@ -239,6 +239,22 @@ pub struct ImageDiff {
     pub differing_fraction: f64,
 }
 
+/// The relative RMSE of `a` against the reference `b`, sqrt(Σ(a − b)² / Σ b²), over the pixels `b`
+/// covers (alpha > 0) and all three colour channels. NaN when `b` covers nothing or is black where
+/// it does: there is nothing to be relative to.
+pub fn relative_rmse(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
+    let (mut num, mut den) = (0.0f64, 0.0f64);
+    for (p, q) in a.iter().zip(b) {
+        if q[3] > 0.0 {
+            for c in 0..3 {
+                num += (p[c] as f64 - q[c] as f64).powi(2);
+                den += (q[c] as f64).powi(2);
+            }
+        }
+    }
+    (num / den).sqrt()
+}
+
 pub fn compare(actual: &image::RgbaImage, expected: &image::RgbaImage) -> Result<ImageDiff> {
     if actual.dimensions() != expected.dimensions() {
         return Err(runtime!("image sizes differ: {:?} vs {:?}", actual.dimensions(), expected.dimensions()));

@@ -46,7 +46,7 @@ fn compare(queries: &[Query], gpu: &[f32], model: Model) -> Report {
 fn gpu_matches_cpu_on_random_queries() {
     let (ctx, counts) = validated_context();
     let pass = BssrdfEvalPass::new(&ctx).unwrap();
-    let queries = translucent::physics::random_queries(30_000, 7);
+    let queries = common::random_queries(30_000, 7);
     for model in [Model::Directional, Model::Dipole] {
         let gpu = pass.evaluate(&ctx, &queries, model, Diffusion::Classical).unwrap();
         assert_eq!(gpu.len(), queries.len());

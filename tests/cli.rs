@@ -1,9 +1,12 @@
-//! Bad input through the binary: each case exits 2 with an `error:` line naming the problem, and
-//! never panics or hangs.
+//! The command line itself, through the binary: bad input (each case exits 2 with an `error:` line
+//! naming the problem, and never panics or hangs), the output files and flags of `render`, and
+//! that its flags make the same settings, hence the same frame, as the library's defaults. The
+//! physics and rendering tests (tests/subsurface.rs, tests/render.rs) build frames through the
+//! library.
 
 mod common;
 
-use common::{repo_path, stderr, translucent};
+use common::{output_dir, repo_path, stderr, translucent};
 
 /// Runs `render` with `args` and asserts exit code 2 and an `error:` line containing `needle`.
 fn assert_bad_input(args: &[&str], needle: &str) {
@@ -100,4 +103,191 @@ fn bad_hierarchy_input() {
     assert_bad_input(&["--light", "dir:0,1,0:-2"], "--light");
     let nine: Vec<&str> = (0..9).flat_map(|_| ["--light", "dir:0,1,0"]).collect();
     assert_bad_input(&nine, "at most 8 lights");
+}
+
+#[test]
+fn exr_output_is_linear_radiance() {
+    let path = output_dir().join("sphere.exr");
+    let out =
+        translucent(&["render", "--validation", "--width", "32", "--height", "32", "--out", path.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let img = image::open(&path).unwrap().into_rgba32f();
+    let centre = img.get_pixel(16, 16);
+    assert_eq!(centre[3], 1.0, "the sphere covers the centre");
+    assert!(centre[0] > 0.0 && centre[0].is_finite());
+    assert_eq!(img.get_pixel(0, 0)[3], 0.0, "the corner is background");
+}
+
+#[test]
+fn profile_json_has_every_pass() {
+    let json_path = output_dir().join("profile.json");
+    let png = output_dir().join("profile.png");
+    let out = translucent(&[
+        "render",
+        "--validation",
+        "--width",
+        "64",
+        "--height",
+        "64",
+        "--frames",
+        "3",
+        "--profile",
+        "--profile-out",
+        json_path.to_str().unwrap(),
+        "--out",
+        png.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(table.contains("shade") && table.contains("frame"), "table:\n{table}");
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json_path).unwrap()).unwrap();
+    let events = v["traceEvents"].as_array().unwrap();
+    for pass in ["shade", "readback"] {
+        let timed: Vec<_> = events.iter().filter(|e| e["name"] == pass).collect();
+        assert_eq!(timed.len(), 3, "{pass}: one event per frame");
+        assert!(timed.iter().all(|e| e["dur"].as_f64().unwrap() > 0.0), "{pass}: positive durations");
+    }
+}
+
+/// `--frames N --spin-light DEG` with `{frame}` in `--out` writes every frame; the light turns
+/// about the vertical axis and the hierarchy is rebuilt, so frames differ, and a whole turn comes
+/// back to the first frame.
+#[test]
+fn spinning_light_writes_every_frame() {
+    let dir = output_dir().join("spin");
+    std::fs::create_dir_all(&dir).unwrap();
+    for f in std::fs::read_dir(&dir).unwrap() {
+        std::fs::remove_file(f.unwrap().path()).unwrap();
+    }
+    let pattern = dir.join("frame-{frame}.exr");
+    let out = translucent(&[
+        "render",
+        "--validation",
+        "--mesh",
+        "torus",
+        "--width",
+        "32",
+        "--height",
+        "32",
+        "--samples",
+        "4096",
+        "--light",
+        "dir:1,0.5,0",
+        "--frames",
+        "5",
+        "--spin-light",
+        "90",
+        "--out",
+        pattern.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let frames: Vec<Vec<f32>> = (0..5)
+        .map(|k| {
+            let path = dir.join(format!("frame-{k:04}.exr"));
+            image::open(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display())).into_rgba32f().into_raw()
+        })
+        .collect();
+    let relative_difference = |a: &[f32], b: &[f32]| {
+        let num: f64 = a.iter().zip(b).map(|(x, y)| (*x as f64 - *y as f64).powi(2)).sum();
+        let den: f64 = b.iter().map(|y| (*y as f64).powi(2)).sum();
+        (num / den).sqrt()
+    };
+    let quarter = relative_difference(&frames[1], &frames[0]);
+    let turn = relative_difference(&frames[4], &frames[0]);
+    println!("spinning light: a quarter turn changes the image by {quarter:.3}, a whole turn by {turn:.2e}");
+    assert!(quarter > 0.05, "the light did not move: {quarter}");
+    assert!(turn < 1e-3, "a whole turn must come back to the first frame: {turn}");
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 5, "one file per frame");
+}
+
+/// The layer forced from outside, as users and reviewers run it, with synchronization validation
+/// and best practices: every kind of frame is clean (any message makes the exit code 1).
+#[test]
+fn forced_layer_with_best_practices_is_clean() {
+    let out = output_dir().join("forced.png");
+    let out = out.to_str().unwrap();
+    let tree = output_dir().join("forced-tree.exr");
+    #[rustfmt::skip]
+    let cases: [&[&str]; 4] = [
+        &["--frames", "2", "--spin-light", "30", "--profile"],
+        &["--mesh", "torus", "--brute-force", "--samples", "9000", "--light", "point:2,2,2:3", "--light", "dir:0,1,0"],
+        &["--mesh", "sphere", "--show", "samples", "--exposure", "1"],
+        &["--mesh", "sphere", "--show", "tree", "--level", "3", "--out", tree.to_str().unwrap()],
+    ];
+    for extra in cases {
+        let mut args = vec!["render", "--width", "40", "--height", "30"];
+        args.extend_from_slice(extra);
+        if !extra.contains(&"--out") {
+            args.extend_from_slice(&["--out", out]);
+        }
+        let result = std::process::Command::new(env!("CARGO_BIN_EXE_translucent"))
+            .args(&args)
+            .env("VK_INSTANCE_LAYERS", "VK_LAYER_KHRONOS_validation")
+            .env(
+                "VK_LAYER_ENABLES",
+                "VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT:VK_VALIDATION_FEATURE_ENABLE_BEST_PRACTICES_EXT",
+            )
+            .output()
+            .unwrap();
+        let err = stderr(&result);
+        assert!(result.status.success(), "{extra:?}: exit {:?}\n{err}", result.status.code());
+        assert!(!err.contains("vulkan validation"), "{extra:?}:\n{err}");
+    }
+}
+
+/// `render`'s defaults are the library's: the settings its flags make without any flag are
+/// `SceneSettings::default()` and `RenderSettings::new` with the default material.
+#[test]
+fn render_flags_default_to_the_library_settings() {
+    use clap::Parser;
+    use translucent::cli::{Cli, Command};
+    use translucent::settings::{RenderSettings, SceneSettings};
+    let Command::Render(args) = Cli::try_parse_from(["translucent", "render", "--mesh", "sphere"]).unwrap().command
+    else {
+        panic!("not render")
+    };
+    let scene = SceneSettings { mesh: Some("sphere".into()), ..Default::default() };
+    assert_eq!(SceneSettings::from_args(&args), scene);
+    let flags = RenderSettings::from_args(&args).unwrap();
+    let code = RenderSettings::new(scene.build().unwrap(), translucent::materials::Material::find("marble").unwrap());
+    let (a, b) = (&flags.subsurface, &code.subsurface);
+    assert_eq!((&a.material, a.model, a.diffusion), (&b.material, b.model, b.diffusion));
+    assert_eq!(
+        (a.epsilon, a.brute_force, a.specular, a.roughness),
+        (b.epsilon, b.brute_force, b.specular, b.roughness)
+    );
+    assert_eq!((flags.width, flags.height, flags.samples), (code.width, code.height, code.samples));
+    assert_eq!(
+        (flags.shadow_resolution, flags.show, flags.exposure),
+        (code.shadow_resolution, code.show, code.exposure)
+    );
+    assert_eq!((flags.profile, flags.count_work), (code.profile, code.count_work));
+}
+
+/// The binary renders exactly what the library renders from the same settings: the EXR of
+/// `translucent render` and the library's frame are bit-identical.
+#[test]
+fn render_writes_the_library_frame() {
+    use translucent::settings::{RenderSettings, SceneSettings};
+    let path = output_dir().join("cli-vs-library.exr");
+    #[rustfmt::skip]
+    let out = translucent(&[
+        "render", "--validation", "--mesh", "torus", "--width", "24", "--height", "20", "--samples", "3000",
+        "--light", "dir:0.2,1,0.4:2", "--model", "dipole", "--epsilon", "0.1", "--out", path.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let cli = image::open(&path).unwrap().into_rgba32f();
+    let scene = SceneSettings {
+        mesh: Some("torus".into()),
+        lights: vec![common::dir_light([0.2, 1.0, 0.4], [2.0; 3])],
+        ..Default::default()
+    };
+    let mut s = RenderSettings::new(scene.build().unwrap(), translucent::materials::Material::find("marble").unwrap());
+    (s.width, s.height, s.samples) = (24, 20, Some(3000));
+    (s.subsurface.model, s.subsurface.epsilon) = (translucent::physics::Model::Dipole, 0.1);
+    let library = common::render_hdr(&s);
+    assert_eq!((cli.width(), cli.height()), (library.width, library.height));
+    let differing =
+        cli.pixels().zip(&library.pixels).filter(|(p, q)| p.0.map(f32::to_bits) != q.map(f32::to_bits)).count();
+    assert_eq!(differing, 0, "pixels differing between the binary and the library");
 }

@@ -82,7 +82,7 @@ fn bssrdf_bad_rows_name_line_and_column() {
 fn bssrdf_handles_100k_rows_quickly() {
     let header = translucent::bssrdf_csv::COLUMNS.join(",");
     let mut input = header + "\n";
-    for q in translucent::physics::random_queries(100_000, 3) {
+    for q in common::random_queries(100_000, 3) {
         let m = q.medium;
         let f = |v: glam::DVec3| format!("{},{},{}", v.x, v.y, v.z);
         input += &format!(

@@ -261,7 +261,7 @@ fn check_argv(argv: &[String]) -> Result<(), TestCaseError> {
             if args.mesh.as_deref().is_some_and(|m| !["sphere", "box", "slab", "torus"].contains(&m)) {
                 return Ok(()); // files are the OBJ property's business
             }
-            match translucent::cli::build_scene(&args) {
+            match translucent::settings::SceneSettings::from_args(&args).build() {
                 Ok(scene) => {
                     let c = scene.camera;
                     prop_assert!(c.eye.is_finite() && c.target.is_finite() && c.up.is_finite());

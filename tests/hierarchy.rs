@@ -4,7 +4,8 @@ mod common;
 
 use common::{assert_clean, validated_context};
 use glam::{Vec3, Vec3Swizzles};
-use translucent::hierarchy::{reference_tree, Hierarchy, HierarchyOptions, Snapshot, SurfacePoint, LEAF_BIT};
+use translucent::gpu::{SurfacePoint, LEAF_BIT};
+use translucent::hierarchy::{reference_tree, Hierarchy, HierarchyOptions, Snapshot};
 use translucent::mesh::Mesh;
 use translucent::scene::Light;
 use translucent::vk::BufferUsageFlags;

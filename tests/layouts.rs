@@ -1,8 +1,9 @@
-//! Structs shared between Rust and GLSL: the Rust mirror must have the offsets the SPIR-V declares.
+//! Structs shared between Rust and GLSL (src/gpu/): the Rust mirror must have the offsets the SPIR-V
+//! declares.
 
 use std::mem::{offset_of, size_of};
 
-use translucent::passes::shade::ShadeConstants;
+use translucent::gpu::ShadeConstants;
 use translucent::shaders::member_offsets;
 
 #[test]
@@ -19,8 +20,7 @@ fn shade_constants_match_glsl() {
 
 #[test]
 fn subsurface_params_and_tree_match_glsl() {
-    use translucent::hierarchy::{SurfacePoint, TreeNode};
-    use translucent::passes::shade::SubsurfaceParams;
+    use translucent::gpu::{SubsurfaceParams, SurfacePoint, TreeNode};
     let params = member_offsets("shade.frag", "SubsurfaceParams").expect("SubsurfaceParams");
     let rust: Vec<u32> = [
         offset_of!(SubsurfaceParams, channels),
@@ -78,7 +78,7 @@ fn subsurface_params_and_tree_match_glsl() {
 
 #[test]
 fn light_records_match_glsl() {
-    use translucent::hierarchy::{NodeLight, PointLight};
+    use translucent::gpu::{NodeLight, PointLight};
     let point = member_offsets("hierarchy/tree_aggregate.comp", "PointLight").expect("PointLight");
     assert_eq!(point, [offset_of!(PointLight, irradiance), offset_of!(PointLight, toward_oct)].map(|o| o as u32));
     assert_eq!(size_of::<PointLight>(), 16);
@@ -95,8 +95,7 @@ fn light_records_match_glsl() {
 
 #[test]
 fn bssrdf_structs_match_glsl() {
-    use translucent::passes::bssrdf_eval::BssrdfQueryGpu;
-    use translucent::physics::GpuChannel;
+    use translucent::gpu::{BssrdfQueryGpu, GpuChannel};
     let channel = member_offsets("bssrdf_eval.comp", "BssrdfChannel").expect("BssrdfChannel");
     assert_eq!(channel, (0..16).map(|i| i * 4).collect::<Vec<u32>>());
     assert_eq!(size_of::<GpuChannel>(), 64);
@@ -114,7 +113,7 @@ fn bssrdf_structs_match_glsl() {
 
 #[test]
 fn tonemap_structs_match_glsl() {
-    use translucent::passes::tonemap::{HistogramTables, TonemapConstants, HISTOGRAM_HEADER_BYTES};
+    use translucent::gpu::{HistogramTables, TonemapConstants, HISTOGRAM_HEADER_BYTES};
     let tables = member_offsets("tonemap.comp", "HistogramTables").expect("HistogramTables");
     let rust: Vec<u32> = [
         offset_of!(HistogramTables, thresholds),
@@ -143,15 +142,59 @@ fn tonemap_structs_match_glsl() {
     assert_eq!(histogram.last().copied(), Some(HISTOGRAM_HEADER_BYTES as u32), "bins follow the header");
 }
 
-/// Constants the shaders and Rust share, written in both: the tile lists' and the dipole table's.
 #[test]
-fn shared_constants_match_glsl() {
-    let read = |path: &str| std::fs::read_to_string(format!("{}/shaders/{path}", env!("CARGO_MANIFEST_DIR"))).unwrap();
-    let tiles = read("include/tile_lists.glsl");
-    let tile_size = translucent::passes::tile_cut::TILE_SIZE;
-    assert!(tiles.contains(&format!("const uint TILE_SIZE = {tile_size}u;")), "TILE_SIZE");
-    assert_eq!(translucent::passes::tile_cut::WALK_FROM_ROOT, u32::MAX);
-    assert!(tiles.contains("const uint WALK_FROM_ROOT = 0xffffffffu;"), "WALK_FROM_ROOT");
-    let table_size = translucent::physics::dipole::TABLE_SIZE;
-    assert!(read("include/bssrdf.glsl").contains(&format!("const uint DIPOLE_TABLE_SIZE = {table_size}u;")));
+fn push_constants_match_glsl() {
+    use translucent::gpu::{
+        DebugConstants, EvalConstants, MortonConstants, RadixConstants, SampleConstants, TileCutConstants,
+    };
+    let offsets =
+        |shader: &str, block: &str| member_offsets(shader, block).unwrap_or_else(|| panic!("{block} in {shader}"));
+    assert_eq!(
+        offsets("bssrdf_eval.comp", "EvalConstants"),
+        [offset_of!(EvalConstants, count), offset_of!(EvalConstants, model)].map(|o| o as u32)
+    );
+    let sample = [
+        offset_of!(SampleConstants, point_count),
+        offset_of!(SampleConstants, triangle_count),
+        offset_of!(SampleConstants, seed),
+    ];
+    assert_eq!(offsets("hierarchy/sample_points.comp", "SampleConstants"), sample.map(|o| o as u32));
+    let morton = [
+        offset_of!(MortonConstants, bounds_min),
+        offset_of!(MortonConstants, bounds_extent),
+        offset_of!(MortonConstants, point_count),
+    ];
+    assert_eq!(offsets("hierarchy/morton.comp", "MortonConstants"), morton.map(|o| o as u32));
+    let radix =
+        [offset_of!(RadixConstants, count), offset_of!(RadixConstants, tile_count), offset_of!(RadixConstants, shift)];
+    for shader in ["hierarchy/radix_histogram.comp", "hierarchy/radix_scan.comp", "hierarchy/radix_scatter.comp"] {
+        let glsl = offsets(shader, "RadixConstants");
+        assert_eq!(glsl, radix.map(|o| o as u32), "{shader}");
+    }
+    let cut = [
+        offset_of!(TileCutConstants, tiles),
+        offset_of!(TileCutConstants, pixels),
+        offset_of!(TileCutConstants, capacity),
+        offset_of!(TileCutConstants, light_count),
+    ];
+    assert_eq!(offsets("tile_cut.comp", "TileCutConstants"), cut.map(|o| o as u32));
+    let debug = [offset_of!(DebugConstants, view_projection), offset_of!(DebugConstants, color_scale)];
+    for shader in ["debug/points.vert", "debug/lines.vert"] {
+        assert_eq!(offsets(shader, "DebugConstants"), debug.map(|o| o as u32), "{shader}");
+    }
+}
+
+/// The constants build.rs writes into gpu_constants.glsl are the Rust ones, and the models' GPU
+/// codes are those constants.
+#[test]
+fn shared_constants_are_the_rust_ones() {
+    use translucent::gpu::{self, GLSL_CONSTANTS};
+    use translucent::physics::Model;
+    let value = |name: &str| GLSL_CONSTANTS.iter().find(|(n, _)| *n == name).map(|(_, v)| *v);
+    assert_eq!(value("MODEL_DIRECTIONAL"), Some(Model::Directional.gpu_code()));
+    assert_eq!(value("MODEL_DIPOLE"), Some(Model::Dipole.gpu_code()));
+    assert_ne!(Model::Directional.gpu_code(), Model::Dipole.gpu_code());
+    assert_eq!(value("LEAF_BIT"), Some(gpu::LEAF_BIT));
+    assert_eq!(value("MAX_LIGHTS"), Some(gpu::MAX_LIGHTS as u32));
+    assert_eq!(value("RADIX_TILE"), Some(gpu::RADIX_TILE));
 }

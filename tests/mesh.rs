@@ -76,7 +76,7 @@ fn malformed_obj_files_are_refused_with_the_reason() {
 
 #[test]
 fn stanford_bunny_loads_when_installed() {
-    let path = std::path::Path::new("/usr/share/glmark2/models/bunny.obj");
+    let path = std::path::Path::new(translucent::settings::BUNNY);
     if !path.exists() {
         eprintln!("skipped: {} is not installed (Debian package glmark2-data)", path.display());
         return;

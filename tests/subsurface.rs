@@ -1,42 +1,41 @@
-//! The subsurface shading pass: the tree against brute force, under validation.
+//! The subsurface shading pass: the tree against brute force, and against closed forms and
+//! quadratures, under validation. Frames are built through the library (settings, renderer), as
+//! `translucent render` builds them; tests/cli.rs covers the command line itself.
 
 mod common;
 
-use common::{output_dir, stderr, translucent};
+use common::{dir_light, output_dir, point_light, render_frame, render_hdr};
+use glam::Vec3;
+use translucent::materials::Material;
+use translucent::output::relative_rmse;
+use translucent::physics::Model;
+use translucent::scene::Light;
+use translucent::settings::{RenderSettings, SceneSettings, BUNNY};
 
-/// Renders to EXR (validation on) and returns the linear RGBA pixels.
-fn render(name: &str, args: &[&str]) -> Vec<[f32; 4]> {
-    let path = output_dir().join(format!("{name}.exr"));
-    let mut full =
-        vec!["render", "--validation", "--no-specular", "--width", "64", "--height", "64", "--samples", "4096"];
-    full.extend_from_slice(args);
-    full.extend_from_slice(&["--out", path.to_str().unwrap()]);
-    let out = translucent(&full);
-    assert!(out.status.success(), "{name}: {}", stderr(&out));
-    let img = image::open(&path).unwrap().into_rgba32f();
-    img.pixels().map(|p| p.0).collect()
+/// `scene` in marble at 64x64 with 4096 points, subsurface term only (no specular), directional
+/// dipole: what the tree-against-brute-force tests start from.
+fn settings(scene: &SceneSettings) -> RenderSettings {
+    let mut s = RenderSettings::new(scene.build().expect("scene"), Material::find("marble").unwrap());
+    (s.width, s.height, s.samples) = (64, 64, Some(4096));
+    s.subsurface.specular = false;
+    s
 }
 
-/// sqrt(Σ(a − b)² / Σ b²) over the pixels the object covers, all channels.
-fn relative_rmse(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
-    let (mut num, mut den) = (0.0f64, 0.0f64);
-    for (p, q) in a.iter().zip(b) {
-        if q[3] > 0.0 {
-            for c in 0..3 {
-                num += (p[c] as f64 - q[c] as f64).powi(2);
-                den += (q[c] as f64).powi(2);
-            }
-        }
-    }
-    (num / den).sqrt()
+/// One frame of `settings` (validation on): the linear RGBA pixels.
+fn render(settings: &RenderSettings) -> Vec<[f32; 4]> {
+    render_hdr(settings).pixels
+}
+
+/// `scene` lit by `lights` alone.
+fn lit(scene: &SceneSettings, lights: &[Light]) -> SceneSettings {
+    SceneSettings { lights: lights.to_vec(), ..scene.clone() }
 }
 
 fn meshes() -> Vec<String> {
     let mut m = vec!["sphere".to_string()];
-    let bunny = "/usr/share/glmark2/models/bunny.obj";
     // An irregular mesh: the bunny when installed, else the committed irregular octahedron.
-    if std::path::Path::new(bunny).exists() {
-        m.push(bunny.to_string());
+    if std::path::Path::new(BUNNY).exists() {
+        m.push(BUNNY.to_string());
     } else {
         m.push(common::repo_path("tests/data/irregular.obj").to_string_lossy().into_owned());
     }
@@ -45,18 +44,25 @@ fn meshes() -> Vec<String> {
 
 #[test]
 fn tree_matches_brute_force_within_one_percent() {
-    let light = "dir:0.3,1,-0.5";
+    let light = dir_light([0.3, 1.0, -0.5], [1.0; 3]);
     for mesh in meshes() {
-        for model in ["directional", "dipole"] {
-            let name = format!("{}-{model}", std::path::Path::new(&mesh).file_stem().unwrap().to_string_lossy());
-            let args = ["--mesh", mesh.as_str(), "--light", light, "--model", model];
-            let reference = render(&format!("{name}-brute"), &[&args[..], &["--brute-force"]].concat());
+        for model in [Model::Directional, Model::Dipole] {
+            let name = format!("{}-{model:?}", std::path::Path::new(&mesh).file_stem().unwrap().to_string_lossy());
+            let scene = SceneSettings { mesh: Some(mesh.clone()), lights: vec![light], ..Default::default() };
+            let mut s = settings(&scene);
+            s.subsurface.model = model;
+            s.subsurface.brute_force = true;
+            let reference = render(&s);
+            s.subsurface.brute_force = false;
+            let default_epsilon = s.subsurface.epsilon;
             let mut errors = Vec::new();
-            for eps in ["0.2", "0.1", "0.05", "0.01"] {
-                let tree = render(&format!("{name}-eps{eps}"), &[&args[..], &["--epsilon", eps]].concat());
+            for eps in [0.2, 0.1, 0.05, 0.01] {
+                s.subsurface.epsilon = eps;
+                let tree = render(&s);
                 errors.push(relative_rmse(&tree, &reference));
             }
-            let default = render(&format!("{name}-default"), &args);
+            s.subsurface.epsilon = default_epsilon;
+            let default = render(&s);
             let error = relative_rmse(&default, &reference);
             println!("{name}: relative RMSE at epsilon 0.2, 0.1, 0.05, 0.01: {errors:.5?}; default {error:.5}");
             assert!(error <= 0.01, "{name}: {error}");
@@ -69,56 +75,58 @@ fn tree_matches_brute_force_within_one_percent() {
 /// σs = 2, 3, 1 per mm: 1/σtr = 0.33, 0.44, 0.24 mm), on a slab 8 × 8 × 2 mm (at least 18
 /// diffusion lengths wide), lit from `light_dir`, seen from straight above with a narrow field of
 /// view; returns the centre pixel's radiance per channel.
-/// `extra` picks the integration: `--brute-force` checks the model, sampling and irradiance alone
-/// (`--no-specular` is added unless `extra` has `--roughness`);
+/// `extra` picks the integration: brute force checks the model, sampling and irradiance alone
+/// (the specular lobe is left out unless `extra` asks for it);
 /// the tree's own error (a node at its power centre underestimates a convex Sd) is measured
 /// against brute force in `tree_matches_brute_force_within_one_percent` and printed here.
-fn slab_centre(model: &str, light_dir: &str, extra: &[&str]) -> [f64; 3] {
-    let light = format!("dir:{light_dir}:1");
-    let args = [
-        "--mesh",
-        "slab",
-        "--scale",
-        "2",
-        "--material",
-        "marble",
-        "--sigma-a",
-        "1,0.5,2",
-        "--sigma-s",
-        "2,3,1",
-        "--g",
-        "0",
-        "--eta",
-        "1.3",
-        "--model",
-        model,
-        "--light",
-        &light,
-        "--samples",
-        "80000",
-        "--eye",
-        "0,4,0",
-        "--target",
-        "0,0,0",
-        "--up",
-        "0,0,1",
-        "--fov",
-        "1",
-    ];
-    let path = output_dir().join(format!("slab-{model}-{}-{}.exr", light_dir.replace(',', "_"), extra.join("")));
-    let mut full = vec!["render", "--validation", "--width", "8", "--height", "8"];
-    full.extend_from_slice(&args);
-    full.extend_from_slice(extra);
-    if !extra.contains(&"--roughness") {
-        full.push("--no-specular");
+fn slab_centre(model: Model, light_dir: [f32; 3], extra: Integration) -> [f64; 3] {
+    let scene = slab_scene(light_dir, 1.0);
+    let mut s = slab_settings(&scene, model, 80_000);
+    (s.width, s.height) = (8, 8);
+    match extra {
+        Integration::BruteForce => s.subsurface.brute_force = true,
+        Integration::Tree => {}
+        Integration::TreeWithSpecular(roughness) => (s.subsurface.specular, s.subsurface.roughness) = (true, roughness),
     }
-    full.extend_from_slice(&["--out", path.to_str().unwrap()]);
-    let out = translucent(&full);
-    assert!(out.status.success(), "{}", stderr(&out));
-    let img = image::open(&path).unwrap().into_rgba32f();
-    let p = img.get_pixel(4, 4);
+    let img = render_hdr(&s);
+    let p = img.pixels[(4 * img.width + 4) as usize];
     assert_eq!(p[3], 1.0);
     [p[0] as f64, p[1] as f64, p[2] as f64]
+}
+
+/// How `slab_centre` integrates: brute force or the tree, subsurface term only, or the tree with
+/// the microfacet lobe of this roughness added.
+#[derive(Clone, Copy)]
+enum Integration {
+    BruteForce,
+    Tree,
+    TreeWithSpecular(f32),
+}
+
+/// The slab 8 × 8 × 2 mm (`--mesh slab --scale 2`), lit from `light_dir` with irradiance 1, seen
+/// from straight above (eye (0, 4, 0), up +z) with a field of view of `fov` degrees.
+fn slab_scene(light_dir: [f32; 3], fov: f32) -> SceneSettings {
+    SceneSettings {
+        mesh: Some("slab".into()),
+        scale: 2.0,
+        eye: Some(Vec3::new(0.0, 4.0, 0.0)),
+        target: Some(Vec3::ZERO),
+        up: Vec3::Z,
+        fov,
+        lights: vec![dir_light(light_dir, [1.0; 3])],
+        ..Default::default()
+    }
+}
+
+/// The slab's material (σa = 1, 0.5, 2 and σs = 2, 3, 1 per mm, g = 0, η = 1.3; see
+/// `slab_medium`) under `model`, with `samples` points, subsurface term only.
+fn slab_settings(scene: &SceneSettings, model: Model, samples: u32) -> RenderSettings {
+    let material = Material::custom([1.0, 0.5, 2.0], [2.0, 3.0, 1.0], [0.0; 3], 1.3).unwrap();
+    let mut s = RenderSettings::new(scene.build().expect("slab scene"), material);
+    s.subsurface.model = model;
+    s.subsurface.specular = false;
+    s.samples = Some(samples);
+    s
 }
 
 fn slab_medium(channel: usize) -> translucent::physics::Medium {
@@ -130,8 +138,8 @@ fn slab_medium(channel: usize) -> translucent::physics::Medium {
 fn thick_slab_classical_dipole_equals_the_closed_form() {
     use translucent::physics::{dipole, fresnel, Diffusion};
     let ft0 = fresnel::transmittance(1.3, 1.0);
-    let got = slab_centre("dipole", "0,1,0", &["--brute-force"]);
-    let tree = slab_centre("dipole", "0,1,0", &[]);
+    let got = slab_centre(Model::Dipole, [0.0, 1.0, 0.0], Integration::BruteForce);
+    let tree = slab_centre(Model::Dipole, [0.0, 1.0, 0.0], Integration::Tree);
     for ch in 0..3 {
         let c = slab_medium(ch).constants(Diffusion::Classical);
         let expected = ft0 * ft0 * dipole::total_rd(c.alpha_reduced, c.a_dipole) / std::f64::consts::PI;
@@ -173,11 +181,12 @@ fn thick_slab_directional_dipole_equals_the_plane_integral() {
     use glam::DVec3;
     use translucent::physics::fresnel;
     let ft0 = fresnel::transmittance(1.3, 1.0);
-    for (label, toward) in [("0,1,0", DVec3::Y), ("0.8660254,0.5,0", DVec3::new(0.866_025_4, 0.5, 0.0))] {
+    let oblique = ("0.8660254,0.5,0", DVec3::new(0.866_025_4, 0.5, 0.0), [0.866_025_4, 0.5, 0.0]);
+    for (label, toward, light_dir) in [("0,1,0", DVec3::Y, [0.0, 1.0, 0.0]), oblique] {
         let cos_i = toward.y;
         let irradiance_in = cos_i * fresnel::transmittance(1.3, cos_i);
-        let got = slab_patch_mean("directional", label, 80_000);
-        let tree = slab_centre("directional", label, &[]);
+        let got = slab_patch_mean(Model::Directional, light_dir, 80_000);
+        let tree = slab_centre(Model::Directional, light_dir, Integration::Tree);
         for ch in 0..3 {
             let expected = ft0 * irradiance_in * dirpole_plane_integral(toward.normalize(), ch);
             println!(
@@ -197,8 +206,8 @@ fn specular_lobe_at_normal_incidence_equals_the_closed_form() {
     let roughness = 0.35f64;
     let alpha2 = roughness.powi(4);
     let expected = fresnel::reflectance(1.3, 1.0) / (4.0 * std::f64::consts::PI * alpha2);
-    let without = slab_centre("dipole", "0,1,0", &[]);
-    let with = slab_centre("dipole", "0,1,0", &["--roughness", "0.35"]);
+    let without = slab_centre(Model::Dipole, [0.0, 1.0, 0.0], Integration::Tree);
+    let with = slab_centre(Model::Dipole, [0.0, 1.0, 0.0], Integration::TreeWithSpecular(roughness as f32));
     for ch in 0..3 {
         let lobe = with[ch] - without[ch];
         println!("specular at normal incidence, channel {ch}: {lobe:.6} vs F/(4πα²) = {expected:.6}");
@@ -206,45 +215,36 @@ fn specular_lobe_at_normal_incidence_equals_the_closed_form() {
     }
 }
 
-/// `--profile` reports the work per pixel counted on the GPU: brute force evaluates every point at
-/// every pixel, the tree far fewer.
+/// The work per pixel counted on the GPU (what `--profile` reports): brute force evaluates every
+/// point at every pixel, the tree far fewer.
 #[test]
 fn profile_counts_work_per_pixel() {
-    let run = |extra: &[&str]| {
-        let path = output_dir().join("work.png");
-        let mut args = vec![
-            "render",
-            "--validation",
-            "--mesh",
-            "sphere",
-            "--width",
-            "16",
-            "--height",
-            "16",
-            "--samples",
-            "10000",
-            "--profile",
-        ];
-        args.extend_from_slice(extra);
-        args.extend_from_slice(&["--out", path.to_str().unwrap()]);
-        let out = translucent(&args);
-        assert!(out.status.success(), "{}", stderr(&out));
-        let text = String::from_utf8_lossy(&out.stdout).into_owned();
-        let line = text
-            .lines()
-            .find(|l| l.starts_with("work per pixel"))
-            .unwrap_or_else(|| panic!("no work line in:\n{text}"))
-            .to_string();
-        let numbers: Vec<f64> =
-            line.split(|c: char| !(c.is_ascii_digit() || c == '.')).filter_map(|w| w.parse().ok()).collect();
+    let run = |brute_force: bool| {
+        let scene = SceneSettings { mesh: Some("sphere".into()), ..Default::default() };
+        let mut s = RenderSettings::new(scene.build().unwrap(), Material::find("marble").unwrap());
+        (s.width, s.height, s.samples, s.count_work) = (16, 16, Some(10000), true);
+        s.subsurface.brute_force = brute_force;
+        let (renderer, counts) = render_frame(&s);
+        let work = renderer.work().unwrap();
+        drop(renderer);
+        common::assert_clean(&counts);
+        let mean = |sum: u32| sum as f64 / work.pixels as f64;
         // [pixels, node mean, node max, point mean, point max]
-        (line, numbers)
+        let numbers = vec![
+            work.pixels as f64,
+            mean(work.node_sum),
+            work.node_max as f64,
+            mean(work.point_sum),
+            work.point_max as f64,
+            mean(work.evaluation_sum),
+        ];
+        (format!("work per pixel: {work:?}"), numbers)
     };
-    let (line, brute) = run(&["--brute-force"]);
+    let (line, brute) = run(true);
     println!("{line}");
     assert!(brute[0] > 50.0 && brute[0] <= 256.0, "the sphere covers pixels of the 16x16 image: {brute:?}");
     assert_eq!((brute[3], brute[4]), (10000.0, 10000.0), "brute force evaluates every point once per pixel");
-    let (line, tree) = run(&[]);
+    let (line, tree) = run(false);
     println!("{line}");
     assert!(tree[1] > 1.0 && tree[2] >= tree[1], "nodes visited: {tree:?}");
     assert!(tree[3] < 0.2 * 10000.0, "the tree must evaluate far fewer points than brute force: {tree:?}");
@@ -281,7 +281,7 @@ fn box_obj(lo: [f32; 3], hi: [f32; 3], first_vertex: usize) -> String {
 /// covers the back face for x > 0 either way: the irradiance on the back face is the same, only
 /// the light's direction differs. Returns the red radiance seen from straight above at
 /// (2 mm, 1, 0), brute force.
-fn shadowed_slab(model: &str, travel: f32) -> f64 {
+fn shadowed_slab(model: Model, travel: f32) -> f64 {
     let mesh = output_dir().join(format!("shadowed_slab_{travel}.obj"));
     // A ray reaching the back face (y = −1) at x passed the plate's top (y = −11) at
     // x − travel·10√3 and its bottom at x − travel·11√3: the plate's corner nearest the slab's
@@ -291,27 +291,29 @@ fn shadowed_slab(model: &str, travel: f32) -> f64 {
     let obj =
         box_obj([-12.0, -1.0, -6.0], [12.0, 1.0, 6.0], 0) + &box_obj([plate.0, -12.0, -9.0], [plate.1, -11.0, 9.0], 8);
     std::fs::write(&mesh, obj).unwrap();
-    let light = format!("dir:{},-0.5,0:1", -0.866_025_4 * travel);
-    let path = output_dir().join(format!("shadowed-slab-{model}-{travel}.exr"));
-    #[rustfmt::skip]
-    let args = [
-        "render", "--validation", "--width", "8", "--height", "8", "--mesh", mesh.to_str().unwrap(),
-        "--scale", "1", "--material", "marble", "--sigma-a", "0.05", "--sigma-s", "2", "--g", "0",
-        "--eta", "1.3", "--model", model, "--light", &light, "--samples", "200000",
-        "--shadow-resolution", "4096", "--brute-force", "--no-specular", "--eye", "2,40,0", "--target", "2,1,0",
-        "--up", "0,0,1", "--fov", "0.2", "--out", path.to_str().unwrap(),
-    ];
-    let out = translucent(&args);
-    assert!(out.status.success(), "{}", stderr(&out));
-    let img = image::open(&path).unwrap().into_rgba32f();
-    let p = img.get_pixel(4, 4);
+    let scene = SceneSettings {
+        mesh: Some(mesh.to_str().unwrap().to_string()),
+        scale: 1.0,
+        eye: Some(Vec3::new(2.0, 40.0, 0.0)),
+        target: Some(Vec3::new(2.0, 1.0, 0.0)),
+        up: Vec3::Z,
+        fov: 0.2,
+        lights: vec![dir_light([-0.866_025_4 * travel, -0.5, 0.0], [1.0; 3])],
+        ..Default::default()
+    };
+    let material = Material::custom([0.05; 3], [2.0; 3], [0.0; 3], 1.3).unwrap();
+    let mut s = RenderSettings::new(scene.build().expect("shadowed slab"), material);
+    (s.width, s.height, s.samples, s.shadow_resolution) = (8, 8, Some(200_000), 4096);
+    (s.subsurface.model, s.subsurface.brute_force, s.subsurface.specular) = (model, true, false);
+    let img = render_hdr(&s);
+    let p = img.pixels[(4 * img.width + 4) as usize];
     assert_eq!(p[3], 1.0);
     p[0] as f64
 }
 
 /// The same radiance by quadrature in f64 over the lit part of the slab (the back face for
 /// x < 0 and the side facing the light), 0.05 mm cells: Lo = Ft(η, 1) Σ Sd · E cosθ Ft(η, cosθ) dA.
-fn shadowed_slab_quadrature(model: &str, travel: f64) -> f64 {
+fn shadowed_slab_quadrature(model: Model, travel: f64) -> f64 {
     use glam::DVec3;
     use translucent::physics::{dipole, dirpole, fresnel, Diffusion};
     let medium = translucent::physics::Medium { sigma_a: 0.05, sigma_s: 2.0, g: 0.0, eta: 1.3 };
@@ -334,8 +336,8 @@ fn shadowed_slab_quadrature(model: &str, travel: f64) -> f64 {
             for k in 0..(extent_v / h).round() as usize {
                 let xi = at((i as f64 + 0.5) * h, (k as f64 + 0.5) * h);
                 let sd = match model {
-                    "dipole" => dipole::sd(&c, (xo - xi).length()),
-                    _ => dirpole::sd(&c, xi, *ni, toward, xo, no),
+                    Model::Dipole => dipole::sd(&c, (xo - xi).length()),
+                    Model::Directional => dirpole::sd(&c, xi, *ni, toward, xo, no),
                 };
                 sum += sd * entering * h * h;
             }
@@ -359,11 +361,11 @@ fn shadowed_slab_quadrature(model: &str, travel: f64) -> f64 {
 fn back_lit_thin_slab_carries_light_forward() {
     let mut ratios = Vec::new();
     let mut checks = Vec::new();
-    for model in ["directional", "dipole"] {
+    for model in [Model::Directional, Model::Dipole] {
         let (forward, mirrored) = (shadowed_slab(model, 1.0), shadowed_slab(model, -1.0));
         let (q_forward, q_mirrored) = (shadowed_slab_quadrature(model, 1.0), shadowed_slab_quadrature(model, -1.0));
         println!(
-            "back-lit slab, {model}: forward {forward:.5} (quadrature {q_forward:.5}), mirrored {mirrored:.5} (quadrature {q_mirrored:.5}), ratio {:.3} (quadrature {:.3})",
+            "back-lit slab, {model:?}: forward {forward:.5} (quadrature {q_forward:.5}), mirrored {mirrored:.5} (quadrature {q_mirrored:.5}), ratio {:.3} (quadrature {:.3})",
             forward / mirrored,
             q_forward / q_mirrored
         );
@@ -371,8 +373,8 @@ fn back_lit_thin_slab_carries_light_forward() {
         ratios.push((forward / mirrored, q_forward / q_mirrored));
     }
     for (model, got, expected) in checks {
-        assert!(got > 0.0, "{model}: no light came through");
-        assert!((got - expected).abs() <= 0.06 * expected, "{model}: {got} vs quadrature {expected}");
+        assert!(got > 0.0, "{model:?}: no light came through");
+        assert!((got - expected).abs() <= 0.06 * expected, "{model:?}: {got} vs quadrature {expected}");
     }
     let (directional, classical) = (ratios[0], ratios[1]);
     let (rendered, predicted) = (directional.0 / classical.0, directional.1 / classical.1);
@@ -388,27 +390,19 @@ fn back_lit_thin_slab_carries_light_forward() {
 /// to each pixel, which a single pixel does not: the directional dipole peaks within a mean free
 /// path of the exit point, so one pixel's value depends on how near its nearest point is (the
 /// centre pixel of `slab_centre` sits on the edge between the top face's two triangles).
-fn slab_patch_mean(model: &str, light_dir: &str, samples: u32) -> [f64; 3] {
-    let (light, samples) = (format!("dir:{light_dir}:1"), samples.to_string());
-    let path = output_dir().join(format!("slab-patch-{model}-{}-{samples}.exr", light_dir.replace(',', "_")));
-    #[rustfmt::skip]
-    let args = [
-        "render", "--validation", "--width", "8", "--height", "8", "--mesh", "slab", "--scale", "2",
-        "--material", "marble", "--sigma-a", "1,0.5,2", "--sigma-s", "2,3,1", "--g", "0", "--eta", "1.3",
-        "--model", model, "--light", &light, "--samples", &samples, "--brute-force", "--no-specular",
-        "--eye", "0,4,0", "--target", "0,0,0", "--up", "0,0,1", "--fov", "10", "--out", path.to_str().unwrap(),
-    ];
-    let out = translucent(&args);
-    assert!(out.status.success(), "{}", stderr(&out));
-    let img = image::open(&path).unwrap().into_rgba32f();
+fn slab_patch_mean(model: Model, light_dir: [f32; 3], samples: u32) -> [f64; 3] {
+    let scene = slab_scene(light_dir, 10.0);
+    let mut s = slab_settings(&scene, model, samples);
+    (s.width, s.height, s.subsurface.brute_force) = (8, 8, true);
+    let img = render_hdr(&s);
     let mut sum = [0.0f64; 3];
-    for p in img.pixels() {
+    for p in &img.pixels {
         assert_eq!(p[3], 1.0);
         for c in 0..3 {
             sum[c] += p[c] as f64;
         }
     }
-    sum.map(|s| s / img.pixels().len() as f64)
+    sum.map(|s| s / img.pixels.len() as f64)
 }
 
 /// Brute force converges as the sample count grows: on the thick slab lit at normal incidence,
@@ -420,28 +414,28 @@ fn brute_force_converges_as_samples_grow() {
     use glam::DVec3;
     use translucent::physics::{dipole, fresnel, Diffusion};
     let ft0 = fresnel::transmittance(1.3, 1.0);
-    for model in ["directional", "dipole"] {
+    for model in [Model::Directional, Model::Dipole] {
         let expected: Vec<f64> = (0..3)
             .map(|ch| {
                 let c = slab_medium(ch).constants(Diffusion::Classical);
                 match model {
-                    "dipole" => ft0 * ft0 * dipole::total_rd(c.alpha_reduced, c.a_dipole) / std::f64::consts::PI,
-                    _ => ft0 * ft0 * dirpole_plane_integral(DVec3::Y, ch),
+                    Model::Dipole => ft0 * ft0 * dipole::total_rd(c.alpha_reduced, c.a_dipole) / std::f64::consts::PI,
+                    Model::Directional => ft0 * ft0 * dirpole_plane_integral(DVec3::Y, ch),
                 }
             })
             .collect();
         let mut worst = Vec::new();
         for samples in [50_000u32, 160_000, 500_000] {
-            let got = slab_patch_mean(model, "0,1,0", samples);
+            let got = slab_patch_mean(model, [0.0, 1.0, 0.0], samples);
             let errors: Vec<f64> = (0..3).map(|ch| got[ch] / expected[ch] - 1.0).collect();
-            println!("{model} slab, {samples} points, brute force over the patch: error per channel {errors:+.5?}");
+            println!("{model:?} slab, {samples} points, brute force over the patch: error per channel {errors:+.5?}");
             worst.push(errors.iter().fold(0.0f64, |w, e| w.max(e.abs())));
         }
         assert!(
             worst[1] <= worst[0] && worst[2] <= worst[1],
-            "{model}: the error grows with the sample count: {worst:?}"
+            "{model:?}: the error grows with the sample count: {worst:?}"
         );
-        assert!(worst[2] <= 0.005, "{model}: {} at 500k points", worst[2]);
+        assert!(worst[2] <= 0.005, "{model:?}: {} at 500k points", worst[2]);
     }
 }
 
@@ -465,24 +459,21 @@ fn sum_of(parts: &[Vec<[f32; 4]>]) -> Vec<[f32; 4]> {
 /// sum by 3.3%.
 #[test]
 fn lights_add_exactly_under_both_models() {
-    let fixed = ["--mesh", "sphere"];
-    let (a, b) = ("dir:-0.3,0.7,-0.6:2", "point:1.5,1,1.5:4,3,2");
-    for model in ["directional", "dipole"] {
-        for method in [&[][..], &["--brute-force"][..]] {
-            let render_with = |name: &str, lights: &[&str]| {
-                let mut args: Vec<&str> = fixed.to_vec();
-                args.extend_from_slice(&["--model", model]);
-                args.extend_from_slice(method);
-                for l in lights {
-                    args.extend_from_slice(&["--light", l]);
-                }
-                render(&format!("lights-{model}-{}-{name}", method.len()), &args)
+    let fixed = SceneSettings { mesh: Some("sphere".into()), ..Default::default() };
+    let (a, b) = (dir_light([-0.3, 0.7, -0.6], [2.0; 3]), point_light([1.5, 1.0, 1.5], [4.0, 3.0, 2.0]));
+    for model in [Model::Directional, Model::Dipole] {
+        for brute_force in [false, true] {
+            let method = if brute_force { "brute force" } else { "tree" };
+            let render_with = |lights: &[Light]| {
+                let mut s = settings(&lit(&fixed, lights));
+                (s.subsurface.model, s.subsurface.brute_force) = (model, brute_force);
+                render(&s)
             };
-            let both = render_with("both", &[a, b]);
-            let parts = [render_with("a", &[a]), render_with("b", &[b])];
+            let both = render_with(&[a, b]);
+            let parts = [render_with(&[a]), render_with(&[b])];
             let error = relative_rmse(&both, &sum_of(&parts));
-            println!("{model} {method:?}: two lights against the sum of each alone: relative RMSE {error:.2e}");
-            assert!(error <= 1e-3, "{model} {method:?}: {error}");
+            println!("{model:?} {method}: two lights against the sum of each alone: relative RMSE {error:.2e}");
+            assert!(error <= 1e-3, "{model:?} {method}: {error}");
         }
     }
 }
@@ -491,26 +482,18 @@ fn lights_add_exactly_under_both_models() {
 #[test]
 fn eight_lights_add_exactly() {
     let lights = [
-        "dir:-0.3,0.7,-0.6:1",
-        "dir:0.8,0.2,0.3:0.5,0.7,1",
-        "dir:0,-1,0.2:0.3",
-        "dir:0.1,0.3,1:1,0.5,0.2",
-        "point:1.5,1,1.5:2",
-        "point:-1.6,0.4,0.9:1,2,3",
-        "point:0.2,-1.7,-1:3",
-        "point:0,1.8,0:0.5",
+        dir_light([-0.3, 0.7, -0.6], [1.0; 3]),
+        dir_light([0.8, 0.2, 0.3], [0.5, 0.7, 1.0]),
+        dir_light([0.0, -1.0, 0.2], [0.3; 3]),
+        dir_light([0.1, 0.3, 1.0], [1.0, 0.5, 0.2]),
+        point_light([1.5, 1.0, 1.5], [2.0; 3]),
+        point_light([-1.6, 0.4, 0.9], [1.0, 2.0, 3.0]),
+        point_light([0.2, -1.7, -1.0], [3.0; 3]),
+        point_light([0.0, 1.8, 0.0], [0.5; 3]),
     ];
-    let fixed = ["--mesh", "sphere"];
-    let mut all: Vec<&str> = fixed.to_vec();
-    for l in &lights {
-        all.extend_from_slice(&["--light", l]);
-    }
-    let together = render("eight-lights", &all);
-    let parts: Vec<Vec<[f32; 4]>> = lights
-        .iter()
-        .enumerate()
-        .map(|(k, l)| render(&format!("eight-lights-{k}"), &[&fixed[..], &["--light", l]].concat()))
-        .collect();
+    let fixed = SceneSettings { mesh: Some("sphere".into()), ..Default::default() };
+    let together = render(&settings(&lit(&fixed, &lights)));
+    let parts: Vec<Vec<[f32; 4]>> = lights.iter().map(|l| render(&settings(&lit(&fixed, &[*l])))).collect();
     let error = relative_rmse(&together, &sum_of(&parts));
     println!("eight lights against the sum of each alone: relative RMSE {error:.2e}");
     assert!(error <= 1e-3, "{error}");
@@ -537,19 +520,25 @@ fn mean_bias(a: &[[f32; 4]], b: &[[f32; 4]]) -> [f64; 3] {
 /// directional and a point light) and a slab, both models.
 #[test]
 fn tree_has_no_bias_against_brute_force() {
-    let skin = ["--mesh", "sphere", "--scale", "10", "--material", "skin1", "--light", "dir:0.5,1,1:3"];
-    #[rustfmt::skip]
-    let slab = ["--mesh", "slab", "--scale", "2", "--material", "marble", "--sigma-a", "1,0.5,2", "--sigma-s", "2,3,1",
-        "--g", "0", "--eta", "1.3", "--light", "dir:0,1,0:1", "--eye", "0,4,0", "--target", "0,0,0", "--up", "0,0,1",
-        "--fov", "40"];
-    for (scene, args) in [("skin1-sphere", &skin[..]), ("slab", &slab[..])] {
-        for model in ["directional", "dipole"] {
-            let args = [args, &["--model", model]].concat();
-            let brute = render(&format!("bias-{scene}-{model}-brute"), &[&args[..], &["--brute-force"]].concat());
-            let tree = render(&format!("bias-{scene}-{model}-tree"), &args);
+    let skin = SceneSettings {
+        mesh: Some("sphere".into()),
+        scale: 10.0,
+        lights: vec![dir_light([0.5, 1.0, 1.0], [3.0; 3])],
+        ..Default::default()
+    };
+    let slab = slab_scene([0.0, 1.0, 0.0], 40.0);
+    let skin1 = Material::find("skin1").unwrap();
+    let slab_material = Material::custom([1.0, 0.5, 2.0], [2.0, 3.0, 1.0], [0.0; 3], 1.3).unwrap();
+    for (name, scene, material) in [("skin1-sphere", &skin, &skin1), ("slab", &slab, &slab_material)] {
+        for model in [Model::Directional, Model::Dipole] {
+            let mut s = settings(scene);
+            (s.subsurface.material, s.subsurface.model, s.subsurface.brute_force) = (material.clone(), model, true);
+            let brute = render(&s);
+            s.subsurface.brute_force = false;
+            let tree = render(&s);
             let bias = mean_bias(&tree, &brute);
-            println!("{scene} {model}: tree − brute force, mean per channel {bias:+.5?}");
-            assert!(bias.iter().all(|b| b.abs() <= 0.005), "{scene} {model}: bias {bias:?}");
+            println!("{name} {model:?}: tree − brute force, mean per channel {bias:+.5?}");
+            assert!(bias.iter().all(|b| b.abs() <= 0.005), "{name} {model:?}: bias {bias:?}");
         }
     }
 }

@@ -136,7 +136,7 @@ fn gpu_tonemap_matches_cpu() {
     let (scale, auto) = gpu.run(&ctx, &img, Exposure::Auto);
     let cpu_scale = output::auto_exposure_scale(&img);
     assert_eq!(scale.to_bits(), cpu_scale.to_bits(), "GPU scale {scale} vs CPU {cpu_scale}");
-    let header_words = (tonemap::HISTOGRAM_HEADER_BYTES / 4) as usize;
+    let header_words = (translucent::gpu::HISTOGRAM_HEADER_BYTES / 4) as usize;
     let words = gpu.histogram.read::<u32>(header_words + output::HIST_BINS).unwrap();
     let (counted, bins) = (words[1], &words[header_words..]);
     let cpu_bins = output::luminance_histogram(&img);

@@ -1,10 +1,11 @@
 // The BSSRDF in f32, mirroring src/physics/ (f64): exact Fresnel, the classical dipole
 // (Jensen et al. 2001) and the directional dipole (Frisvad et al. 2014). Material constants come
-// precomputed in f64 on the CPU (BssrdfChannel = GpuChannel in src/physics/mod.rs): the 3C2
+// precomputed in f64 on the CPU (BssrdfChannel = GpuChannel in src/gpu/subsurface.rs): the 3C2
 // polynomial behind CE cancels from ~1600 to ~0.4 and must not be evaluated in f32.
 // Conventions: normals outward, wi from the surface toward the light, eta = n_inside/n_outside.
 #ifndef BSSRDF_GLSL
 #define BSSRDF_GLSL
+#include "gpu_constants.glsl"
 
 struct BssrdfChannel {
     float eta;
@@ -55,7 +56,7 @@ float dipole_sd(BssrdfChannel c, float r) {
 // The classical dipole's Sd per channel from its table (mirrors physics::dipole::SdTable):
 // entry i holds Sd at u = i/(DIPOLE_TABLE_SIZE - 1) of u = r/(r + reach), r in mm; linear
 // between entries. A lookup replaces 6 square roots, exponentials and divisions.
-const uint DIPOLE_TABLE_SIZE = 4096u;
+// DIPOLE_TABLE_SIZE comes from src/gpu/constants.rs.
 vec3 dipole_sd_table(usamplerBuffer table, float reach, float r) {
     float x = r / (r + reach) * float(DIPOLE_TABLE_SIZE - 1u);
     float i = min(floor(x), float(DIPOLE_TABLE_SIZE - 2u));

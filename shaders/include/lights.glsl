@@ -1,7 +1,7 @@
-// Lights as the GPU reads them. Mirrored by GpuLight / LightSetHeader in src/passes/irradiance.rs.
+// Lights as the GPU reads them. Mirrored by GpuLight / LightSetHeader in src/gpu/lights.rs.
 #ifndef LIGHTS_GLSL
 #define LIGHTS_GLSL
-const uint MAX_LIGHTS = 8u;
+#include "gpu_constants.glsl"
 struct GpuLight {
     vec4 position;   // xyz: direction toward the light (w = 0) or its position (w = 1)
     vec4 intensity;  // rgb: irradiance at normal incidence (directional) or radiant intensity (point)

@@ -1,7 +1,8 @@
 // Surface samples and the Jensen–Buhler tree nodes. Mirrored by SurfacePoint and TreeNode in
-// src/hierarchy.rs; a test compares the SPIR-V member offsets with the Rust structs.
+// src/gpu/points.rs; a test compares the SPIR-V member offsets with the Rust structs.
 #ifndef POINTS_GLSL
 #define POINTS_GLSL
+#include "gpu_constants.glsl"
 
 // One irradiance sample on the surface (64 bytes).
 struct SurfacePoint {
@@ -25,8 +26,7 @@ struct PointLight {
 };
 
 // A node of the Karras (HPG 2012) binary radix tree over the Morton-sorted points (64 bytes).
-// Children with LEAF_BIT set are point indices (in sorted order), else node indices.
-const uint LEAF_BIT = 0x80000000u;
+// Children with LEAF_BIT (gpu_constants.glsl) set are point indices (in sorted order), else node indices.
 struct TreeNode {
     vec3 power;        // sum of irradiance × area per RGB, over all lights
     float area;        // sum of point areas

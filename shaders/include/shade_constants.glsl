@@ -1,4 +1,4 @@
-// Push constants of the shade pass. Mirrored by `ShadeConstants` in src/passes/shade.rs; a test
+// Push constants of the shade pass. Mirrored by `ShadeConstants` in src/gpu/shade.rs; a test
 // compares the member offsets in the SPIR-V with the Rust struct.
 #ifndef SHADE_CONSTANTS_GLSL
 #define SHADE_CONSTANTS_GLSL

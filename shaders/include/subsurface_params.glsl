@@ -1,4 +1,4 @@
-// Parameters of the subsurface pass. Mirrored by SubsurfaceParams in src/passes/shade.rs.
+// Parameters of the subsurface pass. Mirrored by SubsurfaceParams in src/gpu/subsurface.rs.
 #ifndef SUBSURFACE_PARAMS_GLSL
 #define SUBSURFACE_PARAMS_GLSL
 #include "bssrdf.glsl"

@@ -1,31 +1,12 @@
 //! Evaluates the BSSRDF for a list of queries in a compute shader through `bssrdf.glsl`, the same
 //! code the shading pass uses. Reads: queries. Writes: one Sd per query.
 
-use bytemuck::{Pod, Zeroable};
 use glam::Vec4;
 
 use crate::error::Result;
-use crate::physics::{Diffusion, GpuChannel, Model, Query};
+use crate::gpu::{BssrdfQueryGpu, EvalConstants, GpuChannel};
+use crate::physics::{Diffusion, Model, Query};
 use crate::vk::{Bind, Buffer, BufferUsageFlags, Context, MemoryLocation, Pipeline};
-
-/// Mirrors `BssrdfQuery` in shaders/bssrdf_eval.comp (std430: 64 + 5 × 16 bytes).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct BssrdfQueryGpu {
-    pub channel: GpuChannel,
-    pub xi: Vec4,
-    pub ni: Vec4,
-    pub wi: Vec4,
-    pub xo: Vec4,
-    pub no: Vec4,
-}
-
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct EvalConstants {
-    count: u32,
-    model: u32,
-}
 
 const GROUP: usize = 64;
 
@@ -64,13 +45,7 @@ impl BssrdfEvalPass {
                 BufferUsageFlags::STORAGE_BUFFER,
                 MemoryLocation::GpuToCpu,
             )?;
-            let constants = EvalConstants {
-                count: rows.len() as u32,
-                model: match model {
-                    Model::Directional => 0,
-                    Model::Dipole => 1,
-                },
-            };
+            let constants = EvalConstants { count: rows.len() as u32, model: model.gpu_code() };
             let groups = rows.len().div_ceil(GROUP) as u32;
             ctx.submit(None, |rec| {
                 rec.dispatch(

@@ -2,24 +2,15 @@
 //! `--show tree --level K` the boxes of the nodes K levels below the root.
 //! Reads: sorted points (or a line vertex buffer). Writes: the colour target (depth-tested).
 
-use bytemuck::{Pod, Zeroable};
-use glam::{Mat4, Vec3, Vec4};
+use glam::Vec3;
 
 use crate::error::Result;
-use crate::hierarchy::{TreeNode, LEAF_BIT};
+use crate::gpu::{DebugConstants, TreeNode, LEAF_BIT};
 use crate::vk::{
     self, Bind, Buffer, Context, CullModeFlags, Format, GraphicsDesc, Image, Pipeline, PrimitiveTopology, Recorder,
 };
 
 use super::shade::{COLOR_FORMAT, DEPTH_FORMAT};
-
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-pub struct DebugConstants {
-    pub view_projection: Mat4,
-    /// rgb: colour scale; w: point size in pixels.
-    pub color_scale: Vec4,
-}
 
 pub struct DebugViewPass {
     points: Pipeline,

@@ -2,34 +2,8 @@
 //! Reads: lights, shadow map. Writes: points (irradiance, mean light direction), each light's
 //! record of each point.
 
-use bytemuck::{Pod, Zeroable};
-use glam::Vec4;
-
 use crate::error::Result;
 use crate::vk::{Bind, Buffer, Context, Image, Pipeline, Recorder, Sampler};
-
-pub const MAX_LIGHTS: usize = 8;
-
-/// Mirrors `GpuLight` in shaders/include/lights.glsl.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
-pub struct GpuLight {
-    pub position: Vec4,
-    pub intensity: Vec4,
-    pub first_layer: u32,
-    pub pad: [u32; 3],
-}
-
-/// Mirrors `LightSet` in shaders/include/lights.glsl; the layer matrices follow it in the buffer.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct LightSetHeader {
-    pub light_count: u32,
-    pub eta: f32,
-    pub normal_offset: f32,
-    pub pad: f32,
-    pub lights: [GpuLight; MAX_LIGHTS],
-}
 
 pub struct IrradiancePass {
     pipeline: Pipeline,

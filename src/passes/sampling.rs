@@ -1,18 +1,9 @@
 //! Surface sampling: the triangle-area prefix sum (64-bit fixed point), then N points uniform by area.
 //! Reads: vertices, indices. Writes: area prefix sum, points (unsorted).
 
-use bytemuck::{Pod, Zeroable};
-
 use crate::error::Result;
+use crate::gpu::SampleConstants;
 use crate::vk::{Bind, Buffer, Context, Pipeline, Recorder};
-
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct SampleConstants {
-    point_count: u32,
-    triangle_count: u32,
-    seed: u32,
-}
 
 pub struct SamplingPass {
     areas: Pipeline,

@@ -6,10 +6,8 @@
 //! sorted points, their light records, lights, shadow maps, position and normal; writes: colour,
 //! work counters.
 
-use bytemuck::{Pod, Zeroable};
-use glam::{Mat4, Vec4};
-
 use crate::error::Result;
+use crate::gpu::ShadeConstants;
 use crate::vk::{
     self, Bind, Buffer, Context, CullModeFlags, Format, GraphicsDesc, Image, Pipeline, PrimitiveTopology, Recorder,
     Sampler,
@@ -21,53 +19,9 @@ pub const DEPTH_FORMAT: Format = Format::D32_SFLOAT_S8_UINT;
 /// sees the values a fragment shader on the mesh would have.
 pub const SURFACE_FORMAT: Format = Format::R32G32B32A32_SFLOAT;
 
-/// Mirrors `ShadeConstants` in shaders/include/shade_constants.glsl (std430 push constants).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct ShadeConstants {
-    pub view_projection: Mat4,
-    pub eye: Vec4,
-    /// Brute force: first point and count of one draw; draws are added by blending.
-    pub point_range: glam::UVec4,
-}
-
 /// (Point, light) records per brute-force draw: keeps every fragment invocation's loop short
 /// (llvmpipe ends loops after ~65k iterations; a real GPU's watchdog dislikes long draws too).
 pub const POINTS_PER_DRAW: u32 = 8192;
-
-/// Mirrors `SubsurfaceParams` in shaders/include/subsurface_params.glsl.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct SubsurfaceParams {
-    pub channels: [crate::physics::GpuChannel; 3],
-    pub mm_per_unit: f32,
-    pub epsilon: f32,
-    pub model: u32,
-    pub brute_force: u32,
-    pub point_count: u32,
-    pub node_count: u32,
-    /// 1 to count the work per pixel (nodes visited, points evaluated) for `--profile`.
-    pub count_work: u32,
-    /// 1 to add the microfacet lobe.
-    pub specular: u32,
-    pub roughness: f32,
-    /// The scale of the classical dipole's Sd table (`SdTable::reach`), mm.
-    pub dipole_reach: f32,
-    pub pad: [u32; 2],
-}
-
-/// Mirrors `WorkCounters` in shaders/shade.frag.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
-pub struct WorkCounters {
-    pub pixels: u32,
-    pub node_sum: u32,
-    pub node_max: u32,
-    pub point_sum: u32,
-    pub point_max: u32,
-    /// Sd evaluations (three channels each): a point is one per light, a node used whole two.
-    pub evaluation_sum: u32,
-}
 
 /// Everything a shading draw reads, and the targets it writes.
 pub struct ShadeInputs<'a> {

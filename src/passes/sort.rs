@@ -2,31 +2,11 @@
 //! Morton order with their light records. Reads: points, point light records. Writes: keys,
 //! order, sorted points and light records.
 
-use bytemuck::{Pod, Zeroable};
-use glam::{Vec3, Vec4};
+use glam::Vec3;
 
 use crate::error::Result;
+use crate::gpu::{MortonConstants, RadixConstants, RADIX_TILE as TILE};
 use crate::vk::{Bind, Buffer, Context, Pipeline, Recorder};
-
-/// Keys per tile of the radix sort (radix.glsl).
-pub const TILE: u32 = 256;
-
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct MortonConstants {
-    bounds_min: Vec4,
-    bounds_extent: Vec4,
-    point_count: u32,
-    pad: [u32; 3],
-}
-
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct RadixConstants {
-    count: u32,
-    tile_count: u32,
-    shift: u32,
-}
 
 pub struct SortBuffers<'a> {
     pub points: &'a Buffer,

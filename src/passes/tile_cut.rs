@@ -4,27 +4,13 @@
 //! tree nodes, sorted points, the G-buffer's positions. Writes: tile headers, list entries, the
 //! allocation counter.
 
-use bytemuck::{Pod, Zeroable};
-
 use crate::error::Result;
+use crate::gpu::TileCutConstants;
 use crate::vk::{Bind, Buffer, BufferUsageFlags, Context, Image, MemoryLocation, Pipeline, Recorder};
 
-/// Pixels per tile side. Mirrors `TILE_SIZE` in shaders/include/tile_lists.glsl.
-pub const TILE_SIZE: u32 = 8;
-/// A header's frontier count meaning "every pixel walks from the root". Mirrors `WALK_FROM_ROOT`.
-pub const WALK_FROM_ROOT: u32 = u32::MAX;
+pub use crate::gpu::{TILE_SIZE, WALK_FROM_ROOT};
 /// List entries allotted per tile before a frame has told how many it needs.
 const INITIAL_ENTRIES_PER_TILE: u64 = 256;
-
-/// Mirrors the push constants of shaders/tile_cut.comp.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct TileCutConstants {
-    pub tiles: [u32; 2],
-    pub pixels: [u32; 2],
-    pub capacity: u32,
-    pub light_count: u32,
-}
 
 /// The lists of one frame size: a header per tile, the entries, and the allocation counter the
 /// host reads to learn whether every list fitted.

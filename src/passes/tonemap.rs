@@ -2,55 +2,12 @@
 //! coverage, auto exposure from a luminance histogram without reading anything back.
 //! Reads: the HDR colour image (storage, rgba32f). Writes: the histogram and the packed RGBA8 buffer.
 
-use bytemuck::{Pod, Zeroable};
-
 use crate::error::Result;
-use crate::output::{self, Exposure, HIST_BINS, HIST_BINS_PER_STOP, HIST_LOG2_MIN};
+use crate::gpu::{HistogramTables, TonemapConstants, HISTOGRAM_HEADER_BYTES};
+use crate::output::{Exposure, HIST_BINS};
 use crate::runtime;
 use crate::vk::{self, Bind, Buffer, BufferUsageFlags, Context, Format, Image, Pipeline, Recorder};
 
-/// Mirrors `HistogramTables` in shaders/tonemap.comp: the histogram definition of `output`, so the
-/// shader has no constants of its own.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct HistogramTables {
-    pub thresholds: [f32; HIST_BINS_PER_STOP],
-    pub inv_centres: [f32; HIST_BINS_PER_STOP],
-    pub log2_min: i32,
-    pub bin_count: u32,
-}
-
-impl HistogramTables {
-    pub fn new() -> HistogramTables {
-        HistogramTables {
-            thresholds: output::stop_thresholds(),
-            inv_centres: output::bin_inverse_centres(),
-            log2_min: HIST_LOG2_MIN,
-            bin_count: HIST_BINS as u32,
-        }
-    }
-}
-
-impl Default for HistogramTables {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
-/// Mirrors `TonemapConstants` in shaders/tonemap.comp.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct TonemapConstants {
-    pub stage: u32,
-    pub width: u32,
-    pub height: u32,
-    pub fixed_exposure: u32,
-    pub fixed_scale: f32,
-}
-
-/// The histogram buffer starts with this header: the exposure scale (f32) at byte 0, the number of
-/// pixels counted (u32) at byte 4; the bins (u32) follow.
-pub const HISTOGRAM_HEADER_BYTES: u64 = 16;
 const GROUP: u32 = 16;
 
 /// Bytes of the histogram buffer. Usage: STORAGE_BUFFER | TRANSFER_DST (it is cleared with a fill).

@@ -27,8 +27,8 @@ pub fn total_rd(alpha_reduced: f64, a: f64) -> f64 {
     alpha_reduced / 2.0 * (1.0 + (-(4.0 / 3.0) * a * s).exp()) * (-s).exp()
 }
 
-/// Entries of [`SdTable`]. Mirrors `DIPOLE_TABLE_SIZE` in shaders/include/bssrdf.glsl.
-pub const TABLE_SIZE: usize = 4096;
+/// Entries of [`SdTable`] (shared with bssrdf.glsl).
+pub const TABLE_SIZE: usize = crate::gpu::DIPOLE_TABLE_SIZE as usize;
 
 /// The classical dipole's Sd for three channels, tabulated for the shade pass: entry i holds Sd
 /// (1/mm²) at u = i/(TABLE_SIZE − 1) of the map u = r/(r + reach), r in mm, and the last entry

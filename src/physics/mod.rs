@@ -1,5 +1,5 @@
 //! The BSSRDF physics in f64, the reference for tests and tools. `shaders/include/bssrdf.glsl`
-//! mirrors it in f32 for the GPU; [`GpuChannel`] carries the constants computed here to it.
+//! mirrors it in f32 for the GPU; [`crate::gpu::GpuChannel`] carries the constants computed here to it.
 //!
 //! Conventions (see `shared/reference/bssrdf.md`): per colour channel, coefficients in mm⁻¹,
 //! lengths in mm, normals outward, ωi from the surface toward the light, η = n_inside/n_outside.
@@ -8,8 +8,6 @@ pub mod dipole;
 pub mod dirpole;
 pub mod fresnel;
 pub mod microfacet;
-
-use bytemuck::{Pod, Zeroable};
 
 /// Which diffusion coefficient the directional dipole uses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -29,6 +27,16 @@ pub enum Model {
     Directional,
     /// Jensen, Marschner, Levoy, Hanrahan 2001.
     Dipole,
+}
+
+impl Model {
+    /// How the GPU names the model (`SubsurfaceParams.model`, the BSSRDF evaluation's push constant).
+    pub const fn gpu_code(self) -> u32 {
+        match self {
+            Model::Directional => crate::gpu::MODEL_DIRECTIONAL,
+            Model::Dipole => crate::gpu::MODEL_DIPOLE,
+        }
+    }
 }
 
 /// One colour channel of a medium.
@@ -114,56 +122,6 @@ impl Medium {
     }
 }
 
-/// The per-channel constants as the GPU reads them: 16 floats, std430 = C layout. Mirrors
-/// `BssrdfChannel` in `shaders/include/bssrdf.glsl` (checked by a layout test).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
-pub struct GpuChannel {
-    pub eta: f32,
-    pub sigma_tr: f32,
-    pub d: f32,
-    pub de: f32,
-    pub a_dirpole: f32,
-    pub c_phi: f32,
-    pub c_e: f32,
-    /// N/(4π²), the directional dipole's leading factor.
-    pub n_over_4pi2: f32,
-    /// (1/(3σt))², the back-lit real-source offset.
-    pub back_lit_dr2: f32,
-    /// α'/(4π), the classical dipole's leading factor.
-    pub dipole_scale: f32,
-    pub dipole_sigma_tr: f32,
-    pub zr: f32,
-    pub zv: f32,
-    /// 1 where diffusion applies, 0 for a pure-absorber channel.
-    pub transports: f32,
-    pub _pad: [f32; 2],
-}
-
-impl From<&ChannelConstants> for GpuChannel {
-    fn from(c: &ChannelConstants) -> GpuChannel {
-        let pi = std::f64::consts::PI;
-        let inv3t = if c.sigma_t > 0.0 { 1.0 / (3.0 * c.sigma_t) } else { 0.0 };
-        GpuChannel {
-            eta: c.eta as f32,
-            sigma_tr: c.sigma_tr as f32,
-            d: c.d as f32,
-            de: c.de as f32,
-            a_dirpole: c.a_dirpole as f32,
-            c_phi: c.c_phi as f32,
-            c_e: c.c_e as f32,
-            n_over_4pi2: (c.n_norm / (4.0 * pi * pi)) as f32,
-            back_lit_dr2: (inv3t * inv3t) as f32,
-            dipole_scale: (c.alpha_reduced / (4.0 * pi)) as f32,
-            dipole_sigma_tr: c.dipole_sigma_tr as f32,
-            zr: c.zr as f32,
-            zv: c.zv as f32,
-            transports: if c.transports { 1.0 } else { 0.0 },
-            _pad: [0.0; 2],
-        }
-    }
-}
-
 /// One BSSRDF evaluation: a channel of a medium and the geometry (mm, unit vectors).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Query {
@@ -183,57 +141,4 @@ impl Query {
             Model::Dipole => dipole::sd(&c, (self.xo - self.xi).length()),
         }
     }
-}
-
-/// Deterministic random queries over σa 1e-4…1 (log-uniform), σs 0.1…30, g −0.3…0.9, η 1.0…1.6,
-/// in three geometries taken in turn: coplanar, curved (two points on a sphere) and back-lit
-/// (exit on the far side of a slab). The light is in the hemisphere of ni.
-pub fn random_queries(n: usize, seed: u64) -> Vec<Query> {
-    use glam::DVec3;
-    let mut state = seed;
-    // splitmix64: small, good enough for test inputs, no dependency.
-    let mut next = move || {
-        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    };
-    let unit = |next: &mut dyn FnMut() -> f64| {
-        let z = 2.0 * next() - 1.0;
-        let phi = std::f64::consts::TAU * next();
-        let s = (1.0 - z * z).sqrt();
-        DVec3::new(s * phi.cos(), s * phi.sin(), z)
-    };
-    (0..n)
-        .map(|i| {
-            let medium = Medium {
-                sigma_a: 10f64.powf(-4.0 + 4.0 * next()),
-                sigma_s: 0.1 + 29.9 * next(),
-                g: -0.3 + 1.2 * next(),
-                eta: 1.0 + 0.6 * next(),
-            };
-            let (xi, ni, xo, no) = match i % 3 {
-                0 => {
-                    let d = DVec3::new(next() - 0.5, next() - 0.5, 0.0) * 10.0 * next();
-                    (DVec3::ZERO, DVec3::Z, d, DVec3::Z)
-                }
-                1 => {
-                    let radius = 0.5 + 20.0 * next();
-                    let (a, b) = (unit(&mut next), unit(&mut next));
-                    (a * radius, a, b * radius, b)
-                }
-                _ => {
-                    let thickness = 0.1 + 5.0 * next();
-                    let d = DVec3::new(next() - 0.5, next() - 0.5, 0.0) * 4.0;
-                    (DVec3::ZERO, DVec3::Z, d - DVec3::Z * thickness, -DVec3::Z)
-                }
-            };
-            let mut wi = unit(&mut next);
-            if wi.dot(ni) < 0.0 {
-                wi -= 2.0 * wi.dot(ni) * ni;
-            }
-            Query { medium, xi, ni, wi, xo, no }
-        })
-        .collect()
 }

@@ -209,9 +209,7 @@ pub fn parse_line(line: &str) -> std::result::Result<Action, String> {
                 "specular" => Setting::Specular(on_off(value)?),
                 "roughness" => {
                     let r = number(value)?;
-                    if !(r > 0.0 && r <= 1.0) {
-                        return Err(format!("roughness {r}: must be in (0, 1]"));
-                    }
+                    crate::settings::check_roughness(r, "roughness").map_err(|e| e.to_string())?;
                     Setting::Roughness(r)
                 }
                 "model" => Setting::Model(match value {

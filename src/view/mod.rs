@@ -22,12 +22,13 @@ use winit::keyboard::{Key, ModifiersState, NamedKey};
 use winit::raw_window_handle::{HasDisplayHandle, HasWindowHandle};
 use winit::window::{Window, WindowId};
 
-use crate::cli::{self, RenderArgs, ShowArg};
+use crate::cli::RenderArgs;
+use crate::commands::validation_exit_code;
 use crate::error::{Error, Result};
-use crate::frame::{FrameInProgress, FrameOptions, Renderer, Show, SubsurfaceOptions};
-use crate::hierarchy::HierarchyOptions;
+use crate::frame::{FrameInProgress, Renderer, Show, SubsurfaceOptions};
 use crate::output::Exposure;
 use crate::scene::Scene;
+use crate::settings::{RenderSettings, SceneSettings};
 use crate::vk::{self, Context, Image, ImageUsageFlags, PresentMode, Presented, Presenter, TimedScope};
 use crate::{bad_input, runtime};
 use controls::{Action, Drag, ScriptLine, Setting};
@@ -99,27 +100,14 @@ pub fn run(args: &ViewArgs) -> Result<i32> {
         Some(p) => controls::load_script(p)?,
         None => Vec::new(),
     };
-    if !(args.render.roughness > 0.0 && args.render.roughness <= 1.0) {
-        return Err(bad_input!("--roughness {}: must be in (0, 1]", args.render.roughness));
-    }
-    let scene = cli::build_scene(&args.render)?;
-    let material = args.render.material.material()?;
+    let settings = RenderSettings::from_args(&args.render)?;
     if !has_window_system() {
         return Err(no_window_system("neither DISPLAY nor WAYLAND_DISPLAY is set"));
     }
     let event_loop = EventLoop::new().map_err(|e| no_window_system(&format!("cannot connect: {e}")))?;
-    let subsurface = SubsurfaceOptions {
-        material,
-        model: args.render.model.into(),
-        diffusion: args.render.diffusion.into(),
-        epsilon: args.render.epsilon,
-        brute_force: args.render.brute_force,
-        specular: !args.render.no_specular,
-        roughness: args.render.roughness,
-    };
     let mut app = App {
         args,
-        start: Some((scene, subsurface)),
+        start: Some(settings),
         viewer: None,
         error: None,
         validation: None,
@@ -134,7 +122,7 @@ pub fn run(args: &ViewArgs) -> Result<i32> {
         return Err(e);
     }
     Ok(match validation {
-        Some((validating, counts)) => cli::validation_exit_code(validating, &counts),
+        Some((validating, counts)) => validation_exit_code(validating, &counts),
         None => 0,
     })
 }
@@ -142,7 +130,7 @@ pub fn run(args: &ViewArgs) -> Result<i32> {
 struct App<'a> {
     args: &'a ViewArgs,
     /// What the viewer is built from, taken when the window opens.
-    start: Option<(Scene, SubsurfaceOptions)>,
+    start: Option<RenderSettings>,
     viewer: Option<Viewer>,
     error: Option<Error>,
     validation: Option<(bool, Arc<vk::ValidationCounts>)>,
@@ -161,9 +149,9 @@ impl App<'_> {
 
 impl ApplicationHandler for App<'_> {
     fn resumed(&mut self, event_loop: &ActiveEventLoop) {
-        let Some((scene, subsurface)) = self.start.take() else { return };
+        let Some(settings) = self.start.take() else { return };
         let script = std::mem::take(&mut self.script);
-        match Viewer::new(event_loop, self.args, scene, subsurface, script, self.frames_limit) {
+        match Viewer::new(event_loop, self.args, settings, script, self.frames_limit) {
             Ok(viewer) => {
                 self.validation = Some((viewer.renderer.ctx.validation, viewer.renderer.ctx.validation_counts()));
                 self.viewer = Some(viewer);
@@ -433,8 +421,7 @@ impl Viewer {
     fn new(
         event_loop: &ActiveEventLoop,
         args: &ViewArgs,
-        scene: Scene,
-        subsurface: SubsurfaceOptions,
+        mut settings: RenderSettings,
         script: VecDeque<ScriptLine>,
         frames_limit: Option<u32>,
     ) -> Result<Viewer> {
@@ -452,30 +439,11 @@ impl Viewer {
         let presenter = Presenter::new(&ctx, display, handle, (size.width, size.height), args.present_mode.into())?;
         log::info!("window {}x{}, swapchain format {:?}", size.width, size.height, presenter.surface_format());
 
-        let point_count = match r.samples {
-            Some(n) => {
-                crate::hierarchy::check_point_count(&ctx, n, scene.lights.len() as u32)?;
-                n
-            }
-            None => cli::default_point_count(&ctx, &scene, &subsurface.material),
-        };
-        let show = match r.show {
-            ShowArg::Shading => Show::Shading,
-            ShowArg::Samples => Show::Samples,
-            ShowArg::Tree => Show::Tree(r.level),
-        };
-        let eta = subsurface.material.eta as f32;
-        let options = FrameOptions {
-            subsurface: SubsurfaceOptions { material: subsurface.material.clone(), ..subsurface },
-            // The window's size: the renderer follows it from the first frame on.
-            width: size.width.max(1),
-            height: size.height.max(1),
-            profile: true,
-            count_work: r.profile,
-            hierarchy: HierarchyOptions { point_count, shadow_resolution: r.shadow_resolution, eta },
-            show,
-            exposure: r.exposure.map(Exposure::Stops).unwrap_or(Exposure::Auto),
-        };
+        let point_count = settings.point_count(&ctx)?;
+        // The window's size: the renderer follows it from the first frame on.
+        (settings.width, settings.height) = (size.width.max(1), size.height.max(1));
+        let options = settings.frame_options(point_count);
+        let RenderSettings { scene, subsurface, .. } = settings;
         let mut renderer = Renderer::new(ctx, &scene, options)?;
         renderer.set_submission_target(SUBMISSION_TARGET_S);
         if renderer.ctx.info.device_type == ash::vk::PhysicalDeviceType::CPU {
@@ -485,8 +453,13 @@ impl Viewer {
         }
         let (centre, _) = crate::scene::bounding_sphere(&scene.mesh.positions);
         let device_label = device_name.clone();
-        let animation =
-            crate::deform::Animation::new(&cli::mesh_spec(r), &scene.mesh, r.deform, r.deform_period, r.up)?;
+        let animation = crate::deform::Animation::new(
+            &SceneSettings::from_args(r).mesh_spec(),
+            &scene.mesh,
+            r.deform,
+            r.deform_period,
+            r.up,
+        )?;
         let ui = if args.no_panel {
             None
         } else {

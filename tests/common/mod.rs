@@ -5,6 +5,13 @@ use std::path::PathBuf;
 use std::process::{Command, Output};
 use std::sync::Arc;
 
+use glam::Vec3;
+use translucent::frame::Renderer;
+use translucent::mesh::safe_normalize;
+use translucent::output::HdrImage;
+use translucent::physics::{Medium, Query};
+use translucent::scene::Light;
+use translucent::settings::RenderSettings;
 use translucent::vk::{Context, ContextOptions, ValidationCounts};
 
 /// A context with validation and synchronization validation on. The counts are returned separately
@@ -20,6 +27,39 @@ pub fn assert_clean(counts: &ValidationCounts) {
     use std::sync::atomic::Ordering;
     let (w, e) = (counts.warnings.load(Ordering::SeqCst), counts.errors.load(Ordering::SeqCst));
     assert_eq!((w, e), (0, 0), "validation reported {e} error(s) and {w} warning(s); see the log above");
+}
+
+/// Renders one frame of `settings` through the library, as `translucent render --validation` does,
+/// on a context with validation and synchronization validation (any message fails the test).
+/// Returns the renderer, for the image, the tone-mapped image or the work counters; the caller
+/// drops it and then calls [`assert_clean`] on the counts.
+pub fn render_frame(settings: &RenderSettings) -> (Renderer, Arc<ValidationCounts>) {
+    let (ctx, counts) = validated_context();
+    let point_count = settings.point_count(&ctx).expect("sample count");
+    let mut renderer = Renderer::new(ctx, &settings.scene, settings.frame_options(point_count)).expect("renderer");
+    renderer.render_frame(&settings.scene).expect("frame");
+    (renderer, counts)
+}
+
+/// One frame of `settings` (see [`render_frame`]): its linear radiance, validation checked clean.
+pub fn render_hdr(settings: &RenderSettings) -> HdrImage {
+    let (renderer, counts) = render_frame(settings);
+    let image = renderer.image().expect("image");
+    drop(renderer);
+    assert_clean(&counts);
+    image
+}
+
+/// A directional light toward `toward` (normalised as `--light dir:X,Y,Z:I` does) with
+/// irradiance `irradiance` at normal incidence.
+pub fn dir_light(toward: [f32; 3], irradiance: [f32; 3]) -> Light {
+    let toward = safe_normalize(Vec3::from(toward)).expect("a light direction");
+    Light::Directional { toward, irradiance: Vec3::from(irradiance) }
+}
+
+/// A point light at `position` with radiant intensity `intensity` (`--light point:X,Y,Z:I`).
+pub fn point_light(position: [f32; 3], intensity: [f32; 3]) -> Light {
+    Light::Point { position: Vec3::from(position), intensity: Vec3::from(intensity) }
 }
 
 /// Runs the `translucent` binary with `args`.
@@ -40,4 +80,57 @@ pub fn repo_path(rel: &str) -> PathBuf {
 
 pub fn stderr(out: &Output) -> String {
     String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// Deterministic random queries over σa 1e-4…1 (log-uniform), σs 0.1…30, g −0.3…0.9, η 1.0…1.6,
+/// in three geometries taken in turn: coplanar, curved (two points on a sphere) and back-lit
+/// (exit on the far side of a slab). The light is in the hemisphere of ni.
+pub fn random_queries(n: usize, seed: u64) -> Vec<Query> {
+    use glam::DVec3;
+    let mut state = seed;
+    // splitmix64: small, good enough for test inputs, no dependency.
+    let mut next = move || {
+        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let unit = |next: &mut dyn FnMut() -> f64| {
+        let z = 2.0 * next() - 1.0;
+        let phi = std::f64::consts::TAU * next();
+        let s = (1.0 - z * z).sqrt();
+        DVec3::new(s * phi.cos(), s * phi.sin(), z)
+    };
+    (0..n)
+        .map(|i| {
+            let medium = Medium {
+                sigma_a: 10f64.powf(-4.0 + 4.0 * next()),
+                sigma_s: 0.1 + 29.9 * next(),
+                g: -0.3 + 1.2 * next(),
+                eta: 1.0 + 0.6 * next(),
+            };
+            let (xi, ni, xo, no) = match i % 3 {
+                0 => {
+                    let d = DVec3::new(next() - 0.5, next() - 0.5, 0.0) * 10.0 * next();
+                    (DVec3::ZERO, DVec3::Z, d, DVec3::Z)
+                }
+                1 => {
+                    let radius = 0.5 + 20.0 * next();
+                    let (a, b) = (unit(&mut next), unit(&mut next));
+                    (a * radius, a, b * radius, b)
+                }
+                _ => {
+                    let thickness = 0.1 + 5.0 * next();
+                    let d = DVec3::new(next() - 0.5, next() - 0.5, 0.0) * 4.0;
+                    (DVec3::ZERO, DVec3::Z, d - DVec3::Z * thickness, -DVec3::Z)
+                }
+            };
+            let mut wi = unit(&mut next);
+            if wi.dot(ni) < 0.0 {
+                wi -= 2.0 * wi.dot(ni) * ni;
+            }
+            Query { medium, xi, ni, wi, xo, no }
+        })
+        .collect()
 }

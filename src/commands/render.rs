@@ -1,0 +1,123 @@
+//! `translucent render`: frames to an image file (or one per frame), with the GPU timings.
+
+use crate::cli::RenderArgs;
+use crate::error::Result;
+use crate::frame::Renderer;
+use crate::settings::{RenderSettings, SceneSettings};
+use crate::vk::{self, Context};
+use crate::{bad_input, runtime};
+
+use super::{check_output_path, frame_path, validation_exit_code};
+
+pub(super) fn render(args: &RenderArgs) -> Result<i32> {
+    // Check everything the user typed before the (slow) device start.
+    check_output_path(&args.out, "--out", &["png", "exr"])?;
+    if let Some(p) = &args.profile_out {
+        check_output_path(p, "--profile-out", &["json"])?;
+    }
+    let settings = RenderSettings::from_args(args)?;
+    let material = &settings.subsurface.material;
+    // The GPU shades in f32 (see `bssrdf --gpu`).
+    if let Some(ch) = (0..3).find(|&c| material.sigma_a[c] + material.sigma_s[c] > crate::bssrdf_csv::GPU_MAX_SIGMA_T) {
+        return Err(bad_input!(
+            "--sigma-a/--sigma-s: σa + σs = {:e} /mm in channel {ch} is above {:e}, beyond what rendering in f32 can hold",
+            material.sigma_a[ch] + material.sigma_s[ch],
+            crate::bssrdf_csv::GPU_MAX_SIGMA_T
+        ));
+    }
+    let ctx = Context::new(&args.device.options())?;
+    let counts = ctx.validation_counts();
+    let validating = ctx.validation;
+    let device_name = format!("{} ({})", ctx.info.name, ctx.info.driver);
+
+    let point_count = settings.point_count(&ctx)?;
+    crate::budget::check_frame(
+        &ctx,
+        &crate::budget::FrameSizes {
+            width: args.width,
+            height: args.height,
+            shadow_resolution: args.shadow_resolution,
+            shadow_layers: crate::budget::FrameSizes::shadow_layers(&settings.scene.lights),
+            point_count,
+            light_count: settings.scene.lights.len() as u32,
+        },
+    )?;
+    let options = settings.frame_options(point_count);
+    let mut scene = settings.scene;
+    let mut renderer = Renderer::new(ctx, &scene, options)?;
+    // A progress bar over the shading of every frame; indicatif hides it off a terminal.
+    let bar = indicatif::ProgressBar::new(Renderer::progress_length(args.frames));
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {percent}% of {msg}, {eta} left")
+            .map_err(|e| runtime!("progress bar: {e}"))?
+            .progress_chars("=> "),
+    );
+    bar.set_message(format!("{} frame(s)", args.frames));
+    renderer.progress = Some(bar.clone());
+
+    let every_frame = args.out.to_string_lossy().contains("{frame}");
+    let mesh_spec = SceneSettings::from_args(args).mesh_spec();
+    let animation = crate::deform::Animation::new(&mesh_spec, &scene.mesh, args.deform, args.deform_period, args.up)?;
+    let base_lights = scene.lights.clone();
+    let (centre, _) = crate::scene::bounding_sphere(&scene.mesh.positions);
+    let mut frames = Vec::new();
+    for index in 0..args.frames {
+        let angle = (args.spin_light * index as f32).to_radians();
+        scene.lights = base_lights.iter().map(|l| l.rotated(args.up, angle, centre)).collect();
+        if let Some(animation) = animation.as_ref().filter(|_| index > 0) {
+            scene.mesh = animation.mesh(index)?;
+            renderer.set_mesh(&scene.mesh)?;
+        }
+        frames.push(renderer.render_frame(&scene)?);
+        if every_frame {
+            let path = frame_path(&args.out, index);
+            renderer.write_image(&path)?;
+            bar.suspend(|| crate::note!("wrote {}", path.display()));
+        }
+    }
+    bar.finish_and_clear();
+    if !every_frame {
+        if args.width as u64 * args.height as u64 >= 1 << 22 {
+            // Encoding a large image takes seconds after the bar is gone: say what is happening.
+            crate::note!("writing {} ({}x{})…", args.out.display(), args.width, args.height);
+        }
+        renderer.write_image(&args.out)?;
+        crate::note!("wrote {} ({}x{}, {} frame(s))", args.out.display(), args.width, args.height, args.frames);
+    }
+    let work = renderer.work()?;
+    drop(renderer);
+
+    if frames.iter().any(|f| !f.is_empty()) {
+        report_profile(&device_name, frames, args)?;
+    }
+    if args.profile && work.pixels > 0 {
+        let per_pixel = |sum: u32| sum as f64 / work.pixels as f64;
+        crate::error::write_stdout(&format!(
+            "work per pixel (last frame, {} pixels): nodes visited mean {:.1} max {}, points evaluated mean {:.1} max {}, Sd evaluations mean {:.1}\n",
+            work.pixels,
+            per_pixel(work.node_sum),
+            work.node_max,
+            per_pixel(work.point_sum),
+            work.point_max,
+            per_pixel(work.evaluation_sum)
+        ))?;
+    }
+    Ok(validation_exit_code(validating, &counts))
+}
+
+fn report_profile(device: &str, frames: Vec<Vec<vk::TimedScope>>, args: &RenderArgs) -> Result<()> {
+    use crate::profiling::{ProfileReport, Scope};
+    let report = ProfileReport {
+        device: device.to_string(),
+        frames: frames
+            .into_iter()
+            .map(|f| f.into_iter().map(|s| Scope { name: s.name, begin_ns: s.begin_ns, end_ns: s.end_ns }).collect())
+            .collect(),
+    };
+    crate::error::write_stdout(&crate::profiling::format_table(&report))?;
+    if let Some(path) = &args.profile_out {
+        crate::output::write_file(path, crate::profiling::chrome_trace_json(&report).as_bytes())
+            .map_err(|e| runtime!("--profile-out: {e}"))?;
+    }
+    Ok(())
+}

@@ -1,0 +1,47 @@
+// Constants the GPU code and the Rust code share, defined here only. build.rs includes this file
+// and writes every entry of `GLSL_CONSTANTS` into the generated header `gpu_constants.glsl`
+// (`const uint NAME = VALUEu;`), which the shaders include; so this file must stand alone (no
+// `crate::` paths, no `use`).
+
+/// `SubsurfaceParams.model` and the BSSRDF evaluation's push constant: the directional dipole.
+pub const MODEL_DIRECTIONAL: u32 = 0;
+/// The same for the classical dipole.
+pub const MODEL_DIPOLE: u32 = 1;
+
+/// Set in a tree node's child index when the child is a point (index into the sorted points).
+pub const LEAF_BIT: u32 = 0x8000_0000;
+
+/// Lights in a `LightSet` (lights.glsl).
+pub const MAX_LIGHTS: usize = 8;
+
+/// Keys per tile of the radix sort (radix.glsl).
+pub const RADIX_TILE: u32 = 256;
+
+/// Pixels per side of the tile-cut pass's tiles: 8x8 = 64 pixels, a multiple of llvmpipe's 4x4
+/// fragment blocks and of a GPU warp or wave (tile_lists.glsl).
+pub const TILE_SIZE: u32 = 8;
+/// A tile header's frontier count meaning "no list: every pixel walks from the root" (the list
+/// did not fit in the buffer this frame).
+pub const WALK_FROM_ROOT: u32 = u32::MAX;
+/// Steps of one tile's walk in the cut pass (it walks twice; llvmpipe ends an invocation's loops
+/// after ~65k iterations in total).
+pub const MAX_CUT_STEPS: u32 = 24000;
+/// Evaluations in one tile's list (the shade pass loops once per evaluation), past which the cut
+/// pass uses nodes whole.
+pub const MAX_LIST_EVALUATIONS: u32 = 16384;
+/// Entries of the classical dipole's Sd table (`physics::dipole::SdTable`, bssrdf.glsl).
+pub const DIPOLE_TABLE_SIZE: u32 = 4096;
+
+/// Every constant of the GLSL header, by its GLSL name.
+pub const GLSL_CONSTANTS: &[(&str, u32)] = &[
+    ("MODEL_DIRECTIONAL", MODEL_DIRECTIONAL),
+    ("MODEL_DIPOLE", MODEL_DIPOLE),
+    ("LEAF_BIT", LEAF_BIT),
+    ("MAX_LIGHTS", MAX_LIGHTS as u32),
+    ("RADIX_TILE", RADIX_TILE),
+    ("TILE_SIZE", TILE_SIZE),
+    ("WALK_FROM_ROOT", WALK_FROM_ROOT),
+    ("MAX_CUT_STEPS", MAX_CUT_STEPS),
+    ("MAX_LIST_EVALUATIONS", MAX_LIST_EVALUATIONS),
+    ("DIPOLE_TABLE_SIZE", DIPOLE_TABLE_SIZE),
+];

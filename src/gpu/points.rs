@@ -1,0 +1,52 @@
+//! points.glsl: the surface samples, what each light brings to each, and the tree's nodes.
+
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+
+/// Mirrors `SurfacePoint` in shaders/include/points.glsl (64 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct SurfacePoint {
+    pub position: Vec3,
+    pub area: f32,
+    pub normal: Vec3,
+    pub triangle: u32,
+    pub irradiance: Vec3,
+    pub pad0: f32,
+    pub light_dir: Vec3,
+    pub pad1: f32,
+}
+
+/// Mirrors `PointLight` in shaders/include/points.glsl (16 bytes): one light at one point.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct PointLight {
+    pub irradiance: Vec3,
+    pub toward_oct: u32,
+}
+
+/// Mirrors `NodeLight` in shaders/include/points.glsl (32 bytes): one light over one node.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct NodeLight {
+    pub power: Vec3,
+    pub toward_oct: u32,
+    pub power_center: Vec3,
+    pub spread2: f32,
+}
+
+/// Mirrors `TreeNode` in shaders/include/points.glsl (64 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct TreeNode {
+    pub power: Vec3,
+    pub area: f32,
+    pub center: Vec3,
+    pub left: u32,
+    pub box_half: [u32; 3],
+    pub right: u32,
+    pub normal_oct: u32,
+    pub light_oct: u32,
+    pub first_point: u32,
+    pub point_count: u32,
+}
