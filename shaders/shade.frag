@@ -91,21 +91,21 @@ void point_source(uint index, uint k, uint light_count, out vec3 xi, out vec3 po
     toward_oct = l.w;
 }
 
-// The parameters of one source: node `index` used whole, light k, sigma point `second` (0 or 1).
-// A node used whole is not one source at its power centre c: Sd is convex in distance, so that
+// The two sources of node `index` used whole for light k: sigma points center ± offset, each
+// with half the power. A node used whole is not one source at its power centre c: Sd is convex in distance, so that
 // underestimates it (1-1.5% on a slab). Two sigma points c ± s(u + t), s² = spread²/2 per axis of
 // the node's tangent plane (u toward xo, t across), match the points' mean and second moments, so
 // Sd's curvature along u and t is taken into account to second order.
-void node_source(uint index, uint k, uint second, uint light_count, vec3 ni, vec3 xo, out vec3 xi,
-                 out vec3 power, out uint toward_oct) {
+void node_sigma(uint index, uint k, uint light_count, vec3 ni, vec3 xo, out vec3 center, out vec3 offset,
+                out vec3 power, out uint toward_oct) {
     uint record = (index * light_count + k) * NODE_LIGHT_TEXELS;
     uvec4 power_toward = texel(node_lights, record);
     vec4 center_spread = texel_float(node_lights, record + 1u);
-    vec3 towards_xo = xo - center_spread.xyz;
+    center = center_spread.xyz;
+    vec3 towards_xo = xo - center;
     vec3 u = towards_xo - ni * dot(towards_xo, ni);
     u = dot(u, u) > 0.0 ? normalize(u) : normalize(cross(ni, abs(ni.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0)));
-    vec3 offset = sqrt(0.5 * center_spread.w) * (u + cross(ni, u));
-    xi = center_spread.xyz + (second != 0u ? -offset : offset);
+    offset = sqrt(0.5 * center_spread.w) * (u + cross(ni, u));
     power = 0.5 * uintBitsToFloat(power_toward.xyz);
     toward_oct = power_toward.w;
 }
@@ -172,15 +172,17 @@ void main() {
         }
         evaluated += tile.y;
         entry += tile.y;
-        for (uint e = 0u; e < tile.z * 2u * light_count; ++e) {
-            uint index = tile_entry(entry + e / (2u * light_count));
+        // Both sigma points of a (node, light) in one iteration: its records are loaded once.
+        for (uint e = 0u; e < tile.z * light_count; ++e) {
+            uint index = tile_entry(entry + e / light_count);
             vec3 ni = decode_oct(texel(nodes, index * NODE_TEXELS + 3u).x);
-            vec3 xi, power;
+            vec3 center, offset, power;
             uint toward_oct;
-            node_source(index, (e / 2u) % light_count, e & 1u, light_count, ni, xo, xi, power, toward_oct);
+            node_sigma(index, e % light_count, light_count, ni, xo, center, offset, power, toward_oct);
             if (power == vec3(0.0)) continue;
-            ++evaluations;
-            sum += source(xi, ni, decode_oct(toward_oct), power, xo, no);
+            evaluations += 2u;
+            vec3 wi = decode_oct(toward_oct);
+            sum += source(center + offset, ni, wi, power, xo, no) + source(center - offset, ni, wi, power, xo, no);
         }
         visits += tile.z;
         entry += tile.z;
@@ -245,10 +247,14 @@ void main() {
                 // The rest of this source's evaluations, after this one (it took this entry's place).
                 if (evaluation + 1u < per_light * light_count) stack[top++] = item | ((evaluation + 2u) << EVALUATION_SHIFT);
                 uint k = evaluation / per_light;
-                vec3 xi, power;
+                vec3 xi, power, offset;
                 uint toward_oct;
-                if (is_point) point_source(index, k, light_count, xi, power, toward_oct);
-                else node_source(index, k, evaluation & 1u, light_count, ni, xo, xi, power, toward_oct);
+                if (is_point) {
+                    point_source(index, k, light_count, xi, power, toward_oct);
+                } else {
+                    node_sigma(index, k, light_count, ni, xo, xi, offset, power, toward_oct);
+                    xi += (evaluation & 1u) != 0u ? -offset : offset;
+                }
                 if (power == vec3(0.0)) continue;
                 ++evaluations;
                 sum += source(xi, ni, decode_oct(toward_oct), power, xo, no);
