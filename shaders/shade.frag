@@ -44,6 +44,7 @@ layout(binding = 10) uniform usamplerBuffer tile_headers;
 layout(binding = 11) uniform usamplerBuffer tile_entries;
 // The classical dipole's Sd per channel, tabulated (bssrdf.glsl).
 layout(binding = 12) uniform usamplerBuffer dipole_table;
+vec4 dipole_header; // its texel 0, read once per pixel
 
 const uint STACK_SIZE = 96u;
 // Stack entries: a point or node index (below 2^24, with LEAF_BIT for points) and the number of
@@ -66,7 +67,7 @@ vec3 source(vec3 xi, vec3 ni, vec3 wi, vec3 power, vec3 xo, vec3 no) {
                   dirpole_channel_sd(params.channels[1], g, xi_mm, xo_mm, no),
                   dirpole_channel_sd(params.channels[2], g, xi_mm, xo_mm, no));
     } else {
-        sd = dipole_sd_table(dipole_table, params.dipole_reach, length(xo - xi) * s);
+        sd = dipole_sd_table(dipole_table, dipole_header, length(xo - xi) * s);
     }
     return sd * power * (s * s); // power is irradiance × scene-unit area: to mm²
 }
@@ -139,6 +140,7 @@ void main() {
     }
     vec3 xo = surface.xyz;
     vec3 no = normalize(imageLoad(surface_normal, pixel).xyz);
+    dipole_header = dipole_table_header(dipole_table);
     vec3 wo = normalize(pc.eye.xyz - xo);
     vec3 sum = vec3(0.0);
     uint visits = 0u;

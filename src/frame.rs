@@ -56,8 +56,7 @@ fn subsurface_params(o: &SubsurfaceOptions, mm_per_unit: f32, point_count: u32) 
         count_work: 0,
         specular: o.specular as u32,
         roughness: o.roughness,
-        dipole_reach: dipole_table(o).reach as f32,
-        pad: [0; 2],
+        pad: [0; 3],
     }
 }
 
@@ -307,11 +306,11 @@ impl Renderer {
         let mut dipole_table = Buffer::new(
             &ctx,
             "dipole Sd table",
-            (dipole::TABLE_SIZE * 16) as u64,
+            (dipole::TABLE_SIZE * 16) as u64, // a header texel and TABLE_SIZE - 1 pairs
             BufferUsageFlags::UNIFORM_TEXEL_BUFFER,
             MemoryLocation::CpuToGpu,
         )?;
-        dipole_table.write(0, &self::dipole_table(&subsurface).values)?;
+        dipole_table.write(0, &self::dipole_table(&subsurface).texels())?;
         Ok(Renderer {
             profiler,
             hierarchy,
@@ -398,7 +397,7 @@ impl Renderer {
         let mut params = subsurface_params(subsurface, mm_per_unit, self.hierarchy.point_count);
         params.count_work = count_work;
         self.subsurface_params.write(0, &[params])?;
-        self.dipole_table.write(0, &dipole_table(subsurface).values)?;
+        self.dipole_table.write(0, &dipole_table(subsurface).texels())?;
         self.brute_force = subsurface.brute_force;
         self.model = params.model;
         self.hierarchy.set_eta(subsurface.material.eta as f32)

@@ -33,7 +33,6 @@ fn subsurface_params_and_tree_match_glsl() {
         offset_of!(SubsurfaceParams, count_work),
         offset_of!(SubsurfaceParams, specular),
         offset_of!(SubsurfaceParams, roughness),
-        offset_of!(SubsurfaceParams, dipole_reach),
     ]
     .iter()
     .map(|&o| o as u32)

@@ -54,15 +54,19 @@ float dipole_sd(BssrdfChannel c, float r) {
 }
 
 // The classical dipole's Sd per channel from its table (mirrors physics::dipole::SdTable):
-// entry i holds Sd at u = i/(DIPOLE_TABLE_SIZE - 1) of u = r/(r + reach), r in mm; linear
-// between entries. A lookup replaces 6 square roots, exponentials and divisions.
+// entry i holds Sd / scale (scale = Sd(0)/2^15, f16 stays normal down to 2e-9 Sd(0)) at
+// u = i/(DIPOLE_TABLE_SIZE - 1) of u = r/(r + reach), r in mm,
+// linear between entries. Texel 0 (`header`, read once) holds the scales and the reach;
+// texel 1 + i holds entries i and i + 1 per channel as two f16, so a lookup is one fetch where
+// the closed form costs 6 square roots, exponentials and divisions.
 // DIPOLE_TABLE_SIZE comes from src/gpu/constants.rs.
-vec3 dipole_sd_table(usamplerBuffer table, float reach, float r) {
-    float x = r / (r + reach) * float(DIPOLE_TABLE_SIZE - 1u);
+vec4 dipole_table_header(usamplerBuffer table) { return uintBitsToFloat(texelFetch(table, 0)); }
+vec3 dipole_sd_table(usamplerBuffer table, vec4 header, float r) {
+    float x = r / (r + header.w) * float(DIPOLE_TABLE_SIZE - 1u);
     float i = min(floor(x), float(DIPOLE_TABLE_SIZE - 2u));
-    vec3 a = uintBitsToFloat(texelFetch(table, int(i)).xyz);
-    vec3 b = uintBitsToFloat(texelFetch(table, int(i) + 1).xyz);
-    return mix(a, b, x - i);
+    uvec3 pairs = texelFetch(table, int(i) + 1).xyz;
+    vec2 red = unpackHalf2x16(pairs.x), green = unpackHalf2x16(pairs.y), blue = unpackHalf2x16(pairs.z);
+    return header.xyz * mix(vec3(red.x, green.x, blue.x), vec3(red.y, green.y, blue.y), x - i);
 }
 
 // The ray-source term S'(x, w, r) of the directional dipole.

@@ -13,7 +13,7 @@ struct SubsurfaceParams {
     uint count_work;           // 1: add this pixel's work to the counters (--profile)
     uint specular;             // 1: add the microfacet lobe (--no-specular: 0)
     float roughness;           // of the microfacet lobe; alpha = roughness²
-    float dipole_reach;        // mm: the scale of the classical dipole's Sd table
+    uint pad0;
     uint pad1;
     uint pad2;
 };

@@ -70,7 +70,5 @@ pub struct SubsurfaceParams {
     /// 1 to add the microfacet lobe.
     pub specular: u32,
     pub roughness: f32,
-    /// The scale of the classical dipole's Sd table (`SdTable::reach`), mm.
-    pub dipole_reach: f32,
-    pub pad: [u32; 2],
+    pub pad: [u32; 3],
 }
