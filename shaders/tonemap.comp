@@ -11,12 +11,18 @@ layout(local_size_x = 16, local_size_y = 16) in;
 
 layout(binding = 0, rgba32f) uniform readonly image2D hdr;
 // Mirrors `HistogramTables` in src/gpu/passes.rs (checked by tests/layouts.rs).
-layout(std430, binding = 1) readonly buffer HistogramTables {
-    float thresholds[16];   // lower bin edges within a stop, 2^(j/16)
-    float inv_centres[16];  // 2^(-(j+0.5)/16)
+// A uniform buffer: llvmpipe loads its members once per SIMD group, storage buffers lane by lane.
+// std140 keeps float[16] at a 16-byte stride, so the tables are 4 vec4s each (the bytes of
+// float[16] in std430).
+layout(std140, binding = 1) uniform HistogramTables {
+    vec4 thresholds[4];   // lower bin edges within a stop, 2^(j/16)
+    vec4 inv_centres[4];  // 2^(-(j+0.5)/16)
     int log2_min;
     uint bin_count;
 } tables;
+const int BINS_PER_STOP = 16;
+float threshold(int j) { return tables.thresholds[j >> 2][j & 3]; }
+float inv_centre(uint j) { return tables.inv_centres[j >> 2][j & 3u]; }
 // Cleared by the pass before stage 0.
 layout(std430, binding = 2) buffer Histogram {
     float scale;
@@ -50,14 +56,14 @@ int luminance_bin(vec4 p) {
     if (stop < 0) return 0;
     float mantissa = uintBitsToFloat((bits & 0x007fffffu) | 0x3f800000u);
     int within = 0;
-    for (int j = 1; j < tables.thresholds.length(); ++j) within += mantissa >= tables.thresholds[j] ? 1 : 0;
-    return min(stop * tables.thresholds.length() + within, int(tables.bin_count) - 1);
+    for (int j = 1; j < BINS_PER_STOP; ++j) within += mantissa >= threshold(j) ? 1 : 0;
+    return min(stop * BINS_PER_STOP + within, int(tables.bin_count) - 1);
 }
 
 float bin_scale(uint bin) {
-    uint per_stop = uint(tables.inv_centres.length());
+    uint per_stop = uint(BINS_PER_STOP);
     int stop = tables.log2_min + int(bin / per_stop);
-    precise float s = tables.inv_centres[bin % per_stop] * uintBitsToFloat(uint(127 - stop) << 23);
+    precise float s = inv_centre(bin % per_stop) * uintBitsToFloat(uint(127 - stop) << 23);
     return s;
 }
 

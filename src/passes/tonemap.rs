@@ -29,7 +29,7 @@ impl TonemapPass {
     pub fn new(ctx: &Context) -> Result<TonemapPass> {
         let pipeline = Pipeline::compute(ctx, "tonemap.comp")?;
         let tables =
-            vk::upload_buffer(ctx, "tonemap tables", &[HistogramTables::new()], BufferUsageFlags::STORAGE_BUFFER)?;
+            vk::upload_buffer(ctx, "tonemap tables", &[HistogramTables::new()], BufferUsageFlags::UNIFORM_BUFFER)?;
         Ok(TonemapPass { pipeline, tables })
     }
 
@@ -73,7 +73,7 @@ impl TonemapPass {
                         &self.pipeline,
                         &[
                             Bind::StorageImageRead(hdr),
-                            Bind::Read(&self.tables),
+                            Bind::Uniform(&self.tables),
                             Bind::Write(histogram),
                             // The shader declares it writable (stage 2 writes it).
                             Bind::Write(ldr),
@@ -88,7 +88,7 @@ impl TonemapPass {
         rec.dispatch(
             &self.pipeline,
             // The histogram is declared writable (stages 0 and 1 write it).
-            &[Bind::StorageImageRead(hdr), Bind::Read(&self.tables), Bind::Write(histogram), Bind::Write(ldr)],
+            &[Bind::StorageImageRead(hdr), Bind::Uniform(&self.tables), Bind::Write(histogram), Bind::Write(ldr)],
             bytemuck::bytes_of(&constants),
             groups,
         )
