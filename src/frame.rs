@@ -197,6 +197,8 @@ pub struct Renderer {
     tile_cut: TileCutPass,
     /// The per-tile source lists, sized for the frame and grown when a frame needs more.
     tile_lists: TileLists,
+    /// The most entries the lists may hold, when set lower than the device allows (tests).
+    tile_list_limit: Option<u64>,
     shade: ShadePass,
     /// The lights the hierarchy was last given (re-sent only when they change).
     lights: Vec<crate::scene::Light>,
@@ -284,7 +286,7 @@ impl Renderer {
         )?;
         let shade = ShadePass::new(&ctx)?;
         let tile_cut = TileCutPass::new(&ctx)?;
-        let tile_lists = TileLists::new(&ctx, width, height, None)?;
+        let tile_lists = TileLists::new(&ctx, width, height, None, None)?;
         let hierarchy = Hierarchy::new(&ctx, &scene.mesh, &scene.lights, &hierarchy)?;
         let mut params = subsurface_params(&subsurface, scene.mm_per_unit, hierarchy.point_count);
         params.count_work = count_work as u32;
@@ -321,6 +323,7 @@ impl Renderer {
             model: params.model,
             tile_cut,
             tile_lists,
+            tile_list_limit: None,
             shade,
             lights: scene.lights.clone(),
             tile: DEFAULT_TILE,
@@ -366,7 +369,7 @@ impl Renderer {
         let Targets { color, depth, position, normal, readback, ldr } = Targets::new(&self.ctx, extent)?;
         (self.color, self.depth, self.position, self.normal) = (color, depth, position, normal);
         (self.readback, self.ldr, self.extent) = (readback, ldr, extent);
-        self.tile_lists = TileLists::new(&self.ctx, width, height, None)?;
+        self.tile_lists = TileLists::new(&self.ctx, width, height, None, self.tile_list_limit)?;
         // Learn again whether a frame of this size fits one submission.
         if !self.tile_fixed {
             self.whole_frame = false;
@@ -379,6 +382,22 @@ impl Renderer {
     /// responsive; the default suits GPU watchdogs and the progress bar).
     pub fn set_submission_target(&mut self, seconds: f64) {
         self.submission_target_s = seconds.max(1e-3);
+    }
+
+    /// Tile lists of `capacity` entries from the next frame on, growing when a frame needs more
+    /// up to `limit` entries (beyond it, a tile whose list does not fit is shaded by walking the
+    /// tree from the root per pixel). For tests of those paths; the defaults suit rendering.
+    pub fn set_tile_lists(&mut self, capacity: u64, limit: Option<u64>) -> Result<()> {
+        self.ctx.wait_idle()?;
+        let (w, h) = (self.extent.width, self.extent.height);
+        self.tile_lists = TileLists::new(&self.ctx, w, h, Some(capacity), limit)?;
+        self.tile_list_limit = limit;
+        Ok(())
+    }
+
+    /// Entries the last frame's tile lists asked for, and the entries they hold.
+    pub fn tile_list_entries(&self) -> Result<(u64, u64)> {
+        Ok((self.tile_lists.entries_needed()?, self.tile_lists.capacity))
     }
 
     /// The size of the images rendered.

@@ -11,7 +11,7 @@ use translucent::mesh::Mesh;
 use translucent::output::Exposure;
 use translucent::scene::{bounding_sphere, Camera, Light, Scene};
 
-fn render(brute_force: bool, tiles: &[u32]) -> Vec<Vec<[f32; 4]>> {
+fn torus_renderer(brute_force: bool) -> (Renderer, Scene, std::sync::Arc<translucent::vk::ValidationCounts>) {
     let (ctx, counts) = common::validated_context();
     let mesh = Mesh::from_spec("torus").unwrap();
     let (centre, radius) = bounding_sphere(&mesh.positions);
@@ -36,7 +36,11 @@ fn render(brute_force: bool, tiles: &[u32]) -> Vec<Vec<[f32; 4]>> {
         show: Show::Shading,
         exposure: Exposure::Auto,
     };
-    let mut renderer = Renderer::new(ctx, &scene, options).unwrap();
+    (Renderer::new(ctx, &scene, options).unwrap(), scene, counts)
+}
+
+fn render(brute_force: bool, tiles: &[u32]) -> Vec<Vec<[f32; 4]>> {
+    let (mut renderer, scene, counts) = torus_renderer(brute_force);
     let images = tiles
         .iter()
         .map(|&tile| {
@@ -60,5 +64,52 @@ fn tiles_leave_no_seams() {
             let differing = image.iter().zip(&images[0]).filter(|(a, b)| a != b).count();
             assert_eq!(differing, 0, "brute force {brute_force}: tiling {k} differs in {differing} pixels");
         }
+    }
+}
+
+fn relative_rmse(a: &[[f32; 4]], reference: &[[f32; 4]]) -> f64 {
+    let (mut err, mut norm) = (0.0f64, 0.0f64);
+    for (p, q) in a.iter().zip(reference).filter(|(_, q)| q[3] > 0.0) {
+        for c in 0..3 {
+            err += (p[c] as f64 - q[c] as f64).powi(2);
+            norm += (q[c] as f64).powi(2);
+        }
+    }
+    (err / norm).sqrt()
+}
+
+/// The tile lists' two fall-backs: lists that start too small grow to what the frame needs and
+/// give the same image bit for bit; lists that may not grow leave tiles to walk the tree from the
+/// root per pixel, which stays as close to brute force as the lists are.
+#[test]
+fn tile_lists_grow_or_fall_back_to_walks_from_the_root() {
+    let (mut renderer, scene, counts) = torus_renderer(false);
+    renderer.render_frame(&scene).unwrap();
+    let full = renderer.image().unwrap().pixels;
+    let (needed, capacity) = renderer.tile_list_entries().unwrap();
+    assert!(needed > 1000 && needed <= capacity, "the default lists hold the frame's: {needed} of {capacity}");
+
+    renderer.set_tile_lists(64, None).unwrap();
+    renderer.render_frame(&scene).unwrap();
+    let (_, grown) = renderer.tile_list_entries().unwrap();
+    assert!(grown >= needed, "grown to {grown} for {needed}");
+    assert!(renderer.image().unwrap().pixels == full, "grown lists shade as the default ones");
+
+    renderer.set_tile_lists(needed / 2, Some(needed / 2)).unwrap();
+    renderer.render_frame(&scene).unwrap();
+    let half = renderer.image().unwrap().pixels;
+    renderer.set_tile_lists(4, Some(4)).unwrap();
+    renderer.render_frame(&scene).unwrap();
+    let from_root = renderer.image().unwrap().pixels;
+    drop(renderer);
+    common::assert_clean(&counts);
+
+    let brute = render(true, &[128]).remove(0);
+    let (e_full, e_half, e_root) =
+        (relative_rmse(&full, &brute), relative_rmse(&half, &brute), relative_rmse(&from_root, &brute));
+    println!("relative RMSE against brute force: lists {e_full:.5}, half the lists {e_half:.5}, walks from the root {e_root:.5}");
+    assert!(half != full && from_root != half, "the limits change which tiles walk from the root");
+    for e in [e_full, e_half, e_root] {
+        assert!(e < 0.01, "{e}");
     }
 }

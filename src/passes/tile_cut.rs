@@ -20,15 +20,20 @@ pub struct TileLists {
     allocation: Buffer,
     /// Entries the buffer holds.
     pub capacity: u64,
+    /// The most entries the lists may grow to (the device's limit unless set lower).
+    limit: u64,
     pub tiles: [u32; 2],
     pixels: [u32; 2],
 }
 
 impl TileLists {
-    pub fn new(ctx: &Context, width: u32, height: u32, capacity: Option<u64>) -> Result<TileLists> {
+    /// Lists for a `width` x `height` image holding `capacity` entries (by default 256 per tile),
+    /// which may grow up to `limit` entries (by default the device's limit).
+    pub fn new(ctx: &Context, width: u32, height: u32, capacity: Option<u64>, limit: Option<u64>) -> Result<TileLists> {
         let tiles = [width.div_ceil(TILE_SIZE), height.div_ceil(TILE_SIZE)];
         let tile_count = tiles[0] as u64 * tiles[1] as u64;
-        let capacity = capacity.unwrap_or(tile_count * INITIAL_ENTRIES_PER_TILE).clamp(4, max_entries(ctx));
+        let limit = limit.unwrap_or(u64::MAX).clamp(4, max_entries(ctx));
+        let capacity = capacity.unwrap_or(tile_count * INITIAL_ENTRIES_PER_TILE).clamp(4, limit);
         // TRANSFER_DST: frames without a cut clear the headers.
         let usage =
             BufferUsageFlags::STORAGE_BUFFER | BufferUsageFlags::UNIFORM_TEXEL_BUFFER | BufferUsageFlags::TRANSFER_DST;
@@ -50,6 +55,7 @@ impl TileLists {
                 MemoryLocation::GpuToCpu,
             )?,
             capacity,
+            limit,
             tiles,
             pixels: [width, height],
         })
@@ -60,16 +66,16 @@ impl TileLists {
         Ok(self.allocation.read::<u32>(1)?[0] as u64)
     }
 
-    /// Whether every tile's list fitted, and if not, lists big enough for the last cut's needs
-    /// (a quarter more, within the device's limits), or `None` when they are as big as allowed.
+    /// `None` when every tile's list fitted, or the lists are as big as allowed (tiles whose
+    /// list did not fit then walk from the root per pixel); else lists big enough for the last
+    /// cut's needs (a quarter more, within the limit).
     pub fn grown(&self, ctx: &Context) -> Result<Option<TileLists>> {
         let needed = self.entries_needed()?;
-        let max = max_entries(ctx);
-        if needed <= self.capacity || self.capacity >= max {
+        if needed <= self.capacity || self.capacity >= self.limit {
             return Ok(None);
         }
-        let capacity = (needed + needed / 4).min(max);
-        Ok(Some(TileLists::new(ctx, self.pixels[0], self.pixels[1], Some(capacity))?))
+        let capacity = (needed + needed / 4).min(self.limit);
+        Ok(Some(TileLists::new(ctx, self.pixels[0], self.pixels[1], Some(capacity), Some(self.limit))?))
     }
 }
 
