@@ -3,40 +3,30 @@
 use glam::Vec3;
 
 use crate::bad_input;
+use crate::batching::{FrameShading, ShadeBatching};
 use crate::error::Result;
 use crate::gpu::{DebugConstants, GpuChannel, ShadeConstants, SubsurfaceParams, WorkCounters};
 use crate::hierarchy::{Hierarchy, HierarchyOptions};
 use crate::materials::Material;
 use crate::output::{self, Exposure, HdrImage};
 use crate::passes::debug_view::{self, DebugViewPass};
+use crate::passes::irradiance::IrradiancePass;
+use crate::passes::sampling::SamplingPass;
 use crate::passes::shade::{self, ShadeInputs, ShadePass};
+use crate::passes::shadow::ShadowPass;
+use crate::passes::sort::SortPass;
 use crate::passes::tile_cut::{TileCutPass, TileLists};
 use crate::passes::tonemap::{self, TonemapPass};
+use crate::passes::tree::TreePass;
 use crate::physics::dipole::{self, SdTable};
 use crate::physics::{Diffusion, Model};
 use crate::scene::Scene;
 use crate::vk::{
-    self, Buffer, BufferUsageFlags, Context, Extent2D, GpuProfiler, Image, ImageUsageFlags, MemoryLocation, TimedScope,
+    self, Buffer, BufferUsageFlags, Context, Extent2D, GpuProfiler, Image, ImageUsageFlags, MemoryLocation, Recorder,
+    TimedScope,
 };
 
-/// Shading units for the next submission after `batch` units took `seconds`: as many as fit in
-/// `target` seconds (SUBMISSION_TARGET_S unless set) at that pace, growing at most ×2 per step,
-/// within [1, MAX_UNITS_PER_SUBMISSION].
-fn next_batch_size(batch: usize, seconds: f64, target: f64) -> usize {
-    let per_unit = seconds / batch.max(1) as f64;
-    let fit = (target / per_unit.max(1e-9)).floor() as usize;
-    fit.clamp(1, (2 * batch).clamp(1, MAX_UNITS_PER_SUBMISSION))
-}
-
-/// Whether the next frame shades the whole image as one tile: once a frame's shading took one
-/// submission of under a quarter of the `target` time, and for as long as it stays under the target.
-fn shade_whole_frame(whole_frame: bool, submissions: usize, seconds: f64, target: f64) -> bool {
-    if whole_frame {
-        seconds < target
-    } else {
-        submissions == 1 && seconds < target / 4.0
-    }
-}
+pub use crate::batching::DEFAULT_TILE;
 
 /// The classical dipole's Sd table for the material of `o`.
 fn dipole_table(o: &SubsurfaceOptions) -> SdTable {
@@ -99,7 +89,7 @@ macro_rules! record_tile_cut {
     ($r:expr, $rec:expr) => {{
         let h = &$r.hierarchy;
         let (params, lists) = (&$r.subsurface_params, &$r.tile_lists);
-        $r.tile_cut.record($rec, params, &h.nodes, &h.sorted_points, &$r.position, lists, h.light_count)
+        $r.passes.tile_cut.record($rec, params, &h.nodes, &h.sorted_points, &$r.position, lists, h.light_count)
     }};
 }
 
@@ -109,10 +99,7 @@ pub struct FrameInProgress {
     constants: ShadeConstants,
     units: Vec<shade::ShadeUnit>,
     done: usize,
-    submissions: usize,
-    shading_seconds: f64,
-    /// The longest time a submission took per unit in it.
-    longest_unit_seconds: f64,
+    shading: FrameShading,
     extent: Extent2D,
 }
 
@@ -124,24 +111,12 @@ impl FrameInProgress {
 
     /// The longest time one shading unit (tile) took so far, as measured per submission.
     pub fn longest_unit_seconds(&self) -> f64 {
-        self.longest_unit_seconds
+        self.shading.longest_unit_seconds()
     }
 }
 
 /// The most timestamp scopes one frame may open (each shading submission opens one).
 const MAX_SCOPES: u32 = 4096;
-
-/// Shading is cut into tiles of this many pixels square (and, for brute force, ranges of points).
-pub const DEFAULT_TILE: u32 = 128;
-
-/// Each shading submission takes as many tiles as fit in about this much time, learnt from the
-/// submissions before: short enough for GPU watchdogs (about 2 s on desktop drivers) and for a
-/// moving progress bar, while a fast GPU still shades a frame in one or two submissions.
-const SUBMISSION_TARGET_S: f64 = 0.2;
-
-/// At most this many shading units per submission: each draw takes a descriptor set from the
-/// submission's pool (`SETS_PER_SUBMIT` = 512 in src/vk/commands.rs).
-const MAX_UNITS_PER_SUBMISSION: usize = 256;
 
 /// What to draw: the shaded mesh, or a debug view instead of it (the subsurface pass is skipped).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -194,29 +169,19 @@ pub struct Renderer {
     brute_force: bool,
     /// The model's GPU code (`SubsurfaceParams::model`): which shading pipeline draws.
     model: u32,
-    tile_cut: TileCutPass,
+    passes: Passes,
     /// The per-tile source lists, sized for the frame and grown when a frame needs more.
     tile_lists: TileLists,
     /// The most entries the lists may hold, when set lower than the device allows (tests).
     tile_list_limit: Option<u64>,
-    shade: ShadePass,
     /// The lights the hierarchy was last given (re-sent only when they change).
     lights: Vec<crate::scene::Light>,
-    /// Side of the shading tiles in pixels.
-    tile: u32,
-    /// Shade the whole image as one tile: set once a frame's shading fits one short submission,
-    /// since every tile draws the whole mesh again (unless a tile size was set explicitly).
-    whole_frame: bool,
-    tile_fixed: bool,
+    /// Tile size and units per shading submission, learnt from the frames before.
+    batching: ShadeBatching,
     /// Frames rendered, for the progress bar.
     frames_done: u64,
-    /// Shading units per submission, adapted to `submission_target_s`.
-    units_per_submission: usize,
-    /// How long one shading submission should take (SUBMISSION_TARGET_S unless set).
-    submission_target_s: f64,
     /// Advanced by one per shading unit done, when set (the CLI sets one on a terminal).
     pub progress: Option<indicatif::ProgressBar>,
-    debug_view: DebugViewPass,
     show: Show,
     vertices: Buffer,
     indices: Buffer,
@@ -227,7 +192,6 @@ pub struct Renderer {
     /// The G-buffer of the surface pass: world position and normal per pixel.
     position: Image,
     normal: Image,
-    tonemap: TonemapPass,
     exposure: Exposure,
     histogram: Buffer,
     /// The tone-mapped image, one packed RGBA8 pixel per u32, read by the host.
@@ -284,8 +248,7 @@ impl Renderer {
             BufferUsageFlags::STORAGE_BUFFER | BufferUsageFlags::TRANSFER_DST,
             MemoryLocation::GpuOnly,
         )?;
-        let shade = ShadePass::new(&ctx)?;
-        let tile_cut = TileCutPass::new(&ctx)?;
+        let passes = Passes::new(&ctx)?;
         let tile_lists = TileLists::new(&ctx, width, height, None, None)?;
         let hierarchy = Hierarchy::new(&ctx, &scene.mesh, &scene.lights, &hierarchy)?;
         let mut params = subsurface_params(&subsurface, scene.mm_per_unit, hierarchy.point_count);
@@ -321,19 +284,13 @@ impl Renderer {
             work_counters,
             brute_force: subsurface.brute_force,
             model: params.model,
-            tile_cut,
+            passes,
             tile_lists,
             tile_list_limit: None,
-            shade,
             lights: scene.lights.clone(),
-            tile: DEFAULT_TILE,
-            whole_frame: false,
-            tile_fixed: false,
+            batching: ShadeBatching::default(),
             frames_done: 0,
-            units_per_submission: 1,
-            submission_target_s: SUBMISSION_TARGET_S,
             progress: None,
-            debug_view: DebugViewPass::new(&ctx)?,
             show,
             vertices,
             indices,
@@ -343,7 +300,6 @@ impl Renderer {
             depth,
             position,
             normal,
-            tonemap: TonemapPass::new(&ctx)?,
             exposure,
             histogram,
             ldr,
@@ -371,17 +327,14 @@ impl Renderer {
         (self.readback, self.ldr, self.extent) = (readback, ldr, extent);
         self.tile_lists = TileLists::new(&self.ctx, width, height, None, self.tile_list_limit)?;
         // Learn again whether a frame of this size fits one submission.
-        if !self.tile_fixed {
-            self.whole_frame = false;
-            self.units_per_submission = 1;
-        }
+        self.batching.relearn();
         Ok(())
     }
 
     /// How long one shading submission should take from now on (a window wants short ones to stay
     /// responsive; the default suits GPU watchdogs and the progress bar).
     pub fn set_submission_target(&mut self, seconds: f64) {
-        self.submission_target_s = seconds.max(1e-3);
+        self.batching.set_target(seconds);
     }
 
     /// Tile lists of `capacity` entries from the next frame on, growing when a frame needs more
@@ -463,17 +416,13 @@ impl Renderer {
     fn units(&self) -> Vec<shade::ShadeUnit> {
         // Brute force sums (point, light) records, in ranges.
         let brute_force_points = self.brute_force.then_some(self.hierarchy.point_count * self.hierarchy.light_count);
-        let (w, h) = (self.extent.width, self.extent.height);
-        let tile = if self.whole_frame { w.max(h) } else { self.tile };
-        shade::shade_units(w, h, tile, brute_force_points)
+        self.batching.units(self.extent.width, self.extent.height, brute_force_points)
     }
 
     /// Shades in tiles of `tile` pixels square from the next frame on, always (tests compare
     /// tilings).
     pub fn set_tile_size(&mut self, tile: u32) {
-        self.tile = tile.max(1);
-        self.tile_fixed = true;
-        self.whole_frame = false;
+        self.batching.set_tile_size(tile);
     }
 
     /// Draws `mesh` from the next frame on (a deformed mesh, the next of a sequence): new vertex
@@ -503,203 +452,12 @@ impl Renderer {
 
     /// The side of the shading tiles in pixels (when not shading whole frames).
     pub fn tile_size(&self) -> u32 {
-        self.tile
+        self.batching.tile_size()
     }
 
     /// The progress bar's length for `frames` frames (it counts thousandths of a frame).
     pub fn progress_length(frames: u32) -> u64 {
         frames as u64 * 1000
-    }
-
-    /// Renders one frame and returns its GPU timestamp scopes (empty without a profiler). The
-    /// lights are taken from `scene` every frame, so they may move between frames.
-    pub fn render_frame(&mut self, scene: &Scene) -> Result<Vec<TimedScope>> {
-        let mut frame = self.begin_frame(scene)?;
-        while !self.shade_some(&mut frame, None)? {}
-        self.finish_frame(frame)
-    }
-
-    /// The first part of [`render_frame`](Self::render_frame): the hierarchy and the depth
-    /// pre-pass. Shading follows in [`shade_some`](Self::shade_some) steps (a window spreads them
-    /// over turns of its event loop), then [`finish_frame`](Self::finish_frame). A frame may be
-    /// dropped unfinished; every submission has completed when these return.
-    pub fn begin_frame(&mut self, scene: &Scene) -> Result<FrameInProgress> {
-        let aspect = self.extent.width as f32 / self.extent.height as f32;
-        let view_projection = scene.camera.view_projection(aspect, self.bounds);
-        let constants =
-            ShadeConstants { view_projection, eye: scene.camera.eye.extend(1.0), point_range: glam::UVec4::ZERO };
-        if scene.lights != self.lights {
-            let layers = |lights: &[crate::scene::Light]| crate::budget::FrameSizes::shadow_layers(lights);
-            if scene.lights.len() != self.lights.len() || layers(&scene.lights) != layers(&self.lights) {
-                // Another number of lights (or of point lights): per-light records and shadow
-                // layers are sized at creation, so the hierarchy is made anew.
-                self.ctx.wait_idle()?;
-                let options = HierarchyOptions {
-                    point_count: self.hierarchy.point_count,
-                    shadow_resolution: self.hierarchy.shadow_map.extent.width,
-                    eta: self.hierarchy.eta(),
-                };
-                self.hierarchy = Hierarchy::new(&self.ctx, &scene.mesh, &scene.lights, &options)?;
-            } else {
-                self.hierarchy.set_lights(&scene.mesh, &scene.lights)?;
-            }
-            self.lights = scene.lights.clone();
-        }
-        if self.show == Show::Shading {
-            self.shade.prepare(&self.ctx, self.model, self.brute_force)?;
-        }
-        let inputs = shade_inputs!(self);
-
-        // The frame, in order: the hierarchy (sampling, shadow maps, irradiance, Morton codes,
-        // sort, tree build, summaries; each its own scope), the surface pass (G-buffer), the
-        // tile cut, shading in tiles, debug views, then read-back.
-        let cut = self.show == Show::Shading && !self.brute_force;
-        if let Some(p) = self.profiler.as_mut() {
-            p.begin_frame();
-        }
-        self.ctx.submit(self.profiler.as_mut(), |rec| {
-            self.hierarchy.record(rec, &self.vertices, &self.indices)?;
-            rec.begin_scope("surface");
-            self.shade.record_surface(rec, &inputs, &constants)?;
-            rec.end_scope();
-            if cut {
-                rec.begin_scope("tile cut");
-                record_tile_cut!(self, rec)?;
-                rec.end_scope();
-            } else {
-                // Brute force reads no lists; still, nothing the shader may load is left undefined.
-                rec.fill_buffer(&self.tile_lists.headers, 0)?;
-            }
-            Ok(())
-        })?;
-        if cut {
-            if let Some(lists) = self.tile_lists.grown(&self.ctx)? {
-                // Some tiles' lists did not fit (they would walk from the root): cut again into
-                // lists as big as this frame needs.
-                self.tile_lists = lists;
-                self.ctx.submit(self.profiler.as_mut(), |rec| {
-                    rec.begin_scope("tile cut");
-                    record_tile_cut!(self, rec)?;
-                    rec.end_scope();
-                    Ok(())
-                })?;
-            }
-        }
-        Ok(FrameInProgress {
-            view_projection,
-            constants,
-            // A debug view costs what it draws: no subsurface shading under it (the pre-pass's
-            // depth still hides what is behind the surface).
-            units: if self.show == Show::Shading { self.units() } else { Vec::new() },
-            done: 0,
-            submissions: 0,
-            shading_seconds: 0.0,
-            longest_unit_seconds: 0.0,
-            extent: self.extent,
-        })
-    }
-
-    /// Shading submissions until the frame is shaded, or with a `budget`, until the next one
-    /// would likely overrun it (at least one is made). Returns whether the shading is complete.
-    pub fn shade_some(&mut self, frame: &mut FrameInProgress, budget: Option<std::time::Duration>) -> Result<bool> {
-        if frame.extent != self.extent {
-            return Err(crate::runtime!("a frame begun at one size was continued at another"));
-        }
-        let inputs = shade_inputs!(self);
-        let constants = frame.constants;
-        let started = std::time::Instant::now();
-        // Shading in several submissions, so that none runs long (see SUBMISSION_TARGET_S).
-        let units = &frame.units;
-        while frame.done < units.len() {
-            let spent = started.elapsed().as_secs_f64();
-            if budget.is_some_and(|b| spent > 0.0 && spent + self.submission_target_s > b.as_secs_f64()) {
-                break;
-            }
-            let mut size = self.units_per_submission;
-            if let Some(b) = budget {
-                // Tiles differ in cost (background ones are cheap): with a budget, no more than
-                // the rest of it fits at the slowest pace seen in this frame.
-                let worst = frame.longest_unit_seconds.max(1e-9);
-                size = size.min((((b.as_secs_f64() - spent) / worst).floor() as usize).max(1));
-            }
-            let batch = &units[frame.done..(frame.done + size).min(units.len())];
-            let submitted = std::time::Instant::now();
-            self.ctx.submit(self.profiler.as_mut(), |rec| {
-                rec.begin_scope("shade");
-                for unit in batch {
-                    self.shade.record_unit(rec, &inputs, &constants, unit, self.model)?;
-                }
-                rec.end_scope();
-                Ok(())
-            })?;
-            let seconds = submitted.elapsed().as_secs_f64();
-            frame.done += batch.len();
-            frame.longest_unit_seconds = frame.longest_unit_seconds.max(seconds / batch.len() as f64);
-            (frame.submissions, frame.shading_seconds) = (frame.submissions + 1, frame.shading_seconds + seconds);
-            if let Some(bar) = &self.progress {
-                bar.set_position(self.frames_done * 1000 + (1000 * frame.done / units.len()) as u64);
-            }
-            self.units_per_submission = next_batch_size(batch.len(), seconds, self.submission_target_s);
-        }
-        Ok(frame.done == units.len())
-    }
-
-    /// The last part of a frame: debug views, tone mapping and read-back. Returns the frame's GPU
-    /// timestamp scopes (empty without a profiler).
-    pub fn finish_frame(&mut self, frame: FrameInProgress) -> Result<Vec<TimedScope>> {
-        if frame.done < frame.units.len() || frame.extent != self.extent {
-            return Err(crate::runtime!("finish_frame: the frame's shading is not complete"));
-        }
-        let view_projection = frame.view_projection;
-        self.frames_done += 1;
-        if !self.tile_fixed {
-            self.whole_frame =
-                shade_whole_frame(self.whole_frame, frame.submissions, frame.shading_seconds, self.submission_target_s);
-        }
-
-        if self.show == Show::Samples {
-            self.ctx.submit(self.profiler.as_mut(), |rec| {
-                rec.begin_scope("show samples");
-                let debug = DebugConstants { view_projection, color_scale: Vec3::ONE.extend(2.0) };
-                let n = self.hierarchy.point_count;
-                self.debug_view.record_points(
-                    rec,
-                    &self.color,
-                    &self.depth,
-                    &self.hierarchy.sorted_points,
-                    n,
-                    &debug,
-                )?;
-                rec.end_scope();
-                Ok(())
-            })?;
-        }
-        if let Show::Tree(level) = self.show {
-            // Debug only: the boxes come from a download of the nodes, drawn in a second submission.
-            let nodes = self.hierarchy.download(&self.ctx)?.nodes;
-            let lines = debug_view::tree_level_lines(&nodes, level);
-            if lines.is_empty() {
-                return Err(crate::bad_input!("--level {level}: the tree has no internal nodes that deep"));
-            }
-            let buffer = vk::upload_buffer(&self.ctx, "tree lines", &lines, BufferUsageFlags::VERTEX_BUFFER)?;
-            let debug = DebugConstants { view_projection, color_scale: Vec3::ONE.extend(1.0) };
-            self.ctx.submit(None, |rec| {
-                self.debug_view.record_lines(rec, &self.color, &self.depth, &buffer, lines.len() as u32, &debug)
-            })?;
-        }
-        self.ctx.submit(self.profiler.as_mut(), |rec| {
-            rec.begin_scope("tone mapping");
-            self.tonemap.record(rec, &self.color, &self.histogram, &self.ldr, self.exposure)?;
-            rec.end_scope();
-            rec.begin_scope("readback");
-            rec.host_read(&self.work_counters)?;
-            rec.host_read(&self.ldr)?;
-            rec.copy_image_to_buffer(&self.color, &self.readback)?;
-            rec.end_scope();
-            Ok(())
-        })?;
-        self.check_finite()?;
-        Ok(self.profiler.as_mut().map(|p| p.take_scopes()).unwrap_or_default())
     }
 
     /// Work of the last frame's shading per pixel (zeros unless `count_work` was set).
@@ -758,6 +516,244 @@ impl Renderer {
     }
 }
 
+// The frame, in order: the hierarchy's seven passes (`HierarchyPasses::record`), the surface pass
+// and the tile cut (`Renderer::begin_frame`), shading in tiles (`Renderer::shade_some`), then
+// debug views, tone mapping and read-back (`Renderer::finish_frame`). One line per pass, each in
+// its own timestamp scope (the names are what `--profile` and `bench` report).
+
+/// Every pass's pipelines, made once; what they read and write belongs to the renderer and the
+/// hierarchy.
+struct Passes {
+    hierarchy: HierarchyPasses,
+    tile_cut: TileCutPass,
+    shade: ShadePass,
+    debug_view: DebugViewPass,
+    tonemap: TonemapPass,
+}
+
+impl Passes {
+    fn new(ctx: &Context) -> Result<Passes> {
+        Ok(Passes {
+            hierarchy: HierarchyPasses::new(ctx)?,
+            tile_cut: TileCutPass::new(ctx)?,
+            shade: ShadePass::new(ctx)?,
+            debug_view: DebugViewPass::new(ctx)?,
+            tonemap: TonemapPass::new(ctx)?,
+        })
+    }
+}
+
+/// The pipelines of the passes that rebuild a [`Hierarchy`] (which owns only its buffers).
+pub struct HierarchyPasses {
+    sampling: SamplingPass,
+    shadow: ShadowPass,
+    irradiance: IrradiancePass,
+    sort: SortPass,
+    tree: TreePass,
+}
+
+impl HierarchyPasses {
+    pub fn new(ctx: &Context) -> Result<HierarchyPasses> {
+        Ok(HierarchyPasses {
+            sampling: SamplingPass::new(ctx)?,
+            shadow: ShadowPass::new(ctx)?,
+            irradiance: IrradiancePass::new(ctx)?,
+            sort: SortPass::new(ctx)?,
+            tree: TreePass::new(ctx)?,
+        })
+    }
+
+    /// The frame's first seven passes: `h` rebuilt from the mesh in `vertices` and `indices`.
+    /// Tests and tools record them alone to build a hierarchy.
+    pub fn record(&self, rec: &mut Recorder, h: &Hierarchy, vertices: &Buffer, indices: &Buffer) -> Result<()> {
+        let n = h.point_count;
+        let (sort, tree) = (h.sort_buffers(), h.tree_buffers());
+        // N points uniform by area over the mesh.
+        rec.scope("sampling", |rec| {
+            self.sampling.record(rec, vertices, indices, h.triangle_count, &h.prefix, &h.points, n, h.seed)
+        })?;
+        // Depth from each light, into the layers of one shadow map.
+        rec.scope("shadow maps", |rec| {
+            self.shadow.record(rec, vertices, indices, h.index_count, &h.shadow_map, &h.layer_matrices)
+        })?;
+        // Per point and light: the light entering the surface, and its direction.
+        rec.scope("irradiance", |rec| {
+            let (points, records, lights) = (&h.points, &h.point_lights, &h.lights);
+            self.irradiance.record(rec, points, records, n, lights, &h.shadow_map, &h.shadow_sampler)
+        })?;
+        // A key per point along a Morton curve through the mesh's box.
+        rec.scope("morton codes", |rec| self.sort.record_morton(rec, &sort, n, h.bounds()))?;
+        // The points and their light records in key order.
+        rec.scope("radix sort", |rec| self.sort.record_sort(rec, &sort, n))?;
+        // A binary radix tree over the sorted keys.
+        rec.scope("tree build", |rec| self.tree.record_build(rec, &tree, n))?;
+        // Each node's summary of its points, bottom-up.
+        rec.scope("tree summaries", |rec| self.tree.record_aggregate(rec, &tree, n))
+    }
+}
+
+impl Renderer {
+    /// Renders one frame and returns its GPU timestamp scopes (empty without a profiler). The
+    /// lights are taken from `scene` every frame, so they may move between frames.
+    pub fn render_frame(&mut self, scene: &Scene) -> Result<Vec<TimedScope>> {
+        let mut frame = self.begin_frame(scene)?;
+        while !self.shade_some(&mut frame, None)? {}
+        self.finish_frame(frame)
+    }
+
+    /// The first part of [`render_frame`](Self::render_frame): the hierarchy and the depth
+    /// pre-pass. Shading follows in [`shade_some`](Self::shade_some) steps (a window spreads them
+    /// over turns of its event loop), then [`finish_frame`](Self::finish_frame). A frame may be
+    /// dropped unfinished; every submission has completed when these return.
+    pub fn begin_frame(&mut self, scene: &Scene) -> Result<FrameInProgress> {
+        let aspect = self.extent.width as f32 / self.extent.height as f32;
+        let view_projection = scene.camera.view_projection(aspect, self.bounds);
+        let constants =
+            ShadeConstants { view_projection, eye: scene.camera.eye.extend(1.0), point_range: glam::UVec4::ZERO };
+        if scene.lights != self.lights {
+            let layers = |lights: &[crate::scene::Light]| crate::budget::FrameSizes::shadow_layers(lights);
+            if scene.lights.len() != self.lights.len() || layers(&scene.lights) != layers(&self.lights) {
+                // Another number of lights (or of point lights): per-light records and shadow
+                // layers are sized at creation, so the hierarchy is made anew.
+                self.ctx.wait_idle()?;
+                let options = HierarchyOptions {
+                    point_count: self.hierarchy.point_count,
+                    shadow_resolution: self.hierarchy.shadow_map.extent.width,
+                    eta: self.hierarchy.eta(),
+                };
+                self.hierarchy = Hierarchy::new(&self.ctx, &scene.mesh, &scene.lights, &options)?;
+            } else {
+                self.hierarchy.set_lights(&scene.mesh, &scene.lights)?;
+            }
+            self.lights = scene.lights.clone();
+        }
+        if self.show == Show::Shading {
+            self.passes.shade.prepare(&self.ctx, self.model, self.brute_force)?;
+        }
+        let inputs = shade_inputs!(self);
+
+        let cut = self.show == Show::Shading && !self.brute_force;
+        if let Some(p) = self.profiler.as_mut() {
+            p.begin_frame();
+        }
+        self.ctx.submit(self.profiler.as_mut(), |rec| {
+            // The hierarchy, rebuilt from the mesh: seven passes (listed in `HierarchyPasses::record`).
+            self.passes.hierarchy.record(rec, &self.hierarchy, &self.vertices, &self.indices)?;
+            // The depth pre-pass and the G-buffer (world position and normal per pixel).
+            rec.scope("surface", |rec| self.passes.shade.record_surface(rec, &inputs, &constants))?;
+            if cut {
+                // Per tile, the sources far enough for every pixel in it.
+                rec.scope("tile cut", |rec| record_tile_cut!(self, rec))
+            } else {
+                // Brute force reads no lists; still, nothing the shader may load is left undefined.
+                rec.fill_buffer(&self.tile_lists.headers, 0)
+            }
+        })?;
+        if cut {
+            if let Some(lists) = self.tile_lists.grown(&self.ctx)? {
+                // Some tiles' lists did not fit (they would walk from the root): cut again into
+                // lists as big as this frame needs.
+                self.tile_lists = lists;
+                self.ctx
+                    .submit(self.profiler.as_mut(), |rec| rec.scope("tile cut", |rec| record_tile_cut!(self, rec)))?;
+            }
+        }
+        Ok(FrameInProgress {
+            view_projection,
+            constants,
+            // A debug view costs what it draws: no subsurface shading under it (the pre-pass's
+            // depth still hides what is behind the surface).
+            units: if self.show == Show::Shading { self.units() } else { Vec::new() },
+            done: 0,
+            shading: FrameShading::default(),
+            extent: self.extent,
+        })
+    }
+
+    /// Shading submissions until the frame is shaded, or with a `budget`, until the next one
+    /// would likely overrun it (at least one is made). Returns whether the shading is complete.
+    pub fn shade_some(&mut self, frame: &mut FrameInProgress, budget: Option<std::time::Duration>) -> Result<bool> {
+        if frame.extent != self.extent {
+            return Err(crate::runtime!("a frame begun at one size was continued at another"));
+        }
+        let inputs = shade_inputs!(self);
+        let constants = frame.constants;
+        let started = std::time::Instant::now();
+        // Shading in several submissions, so that none runs long (see src/batching.rs).
+        let units = &frame.units;
+        while frame.done < units.len() {
+            let spent = started.elapsed().as_secs_f64();
+            let Some(size) = self.batching.next_batch(&frame.shading, spent, budget) else { break };
+            let batch = &units[frame.done..(frame.done + size).min(units.len())];
+            let submitted = std::time::Instant::now();
+            // The subsurface term and the specular lobe per pixel, a batch of tiles at a time.
+            self.ctx.submit(self.profiler.as_mut(), |rec| {
+                rec.scope("shade", |rec| {
+                    batch
+                        .iter()
+                        .try_for_each(|unit| self.passes.shade.record_unit(rec, &inputs, &constants, unit, self.model))
+                })
+            })?;
+            let seconds = submitted.elapsed().as_secs_f64();
+            frame.done += batch.len();
+            self.batching.after_submission(&mut frame.shading, batch.len(), seconds);
+            if let Some(bar) = &self.progress {
+                bar.set_position(self.frames_done * 1000 + (1000 * frame.done / units.len()) as u64);
+            }
+        }
+        Ok(frame.done == units.len())
+    }
+
+    /// The last part of a frame: debug views, tone mapping and read-back. Returns the frame's GPU
+    /// timestamp scopes (empty without a profiler).
+    pub fn finish_frame(&mut self, frame: FrameInProgress) -> Result<Vec<TimedScope>> {
+        if frame.done < frame.units.len() || frame.extent != self.extent {
+            return Err(crate::runtime!("finish_frame: the frame's shading is not complete"));
+        }
+        let view_projection = frame.view_projection;
+        self.frames_done += 1;
+        self.batching.after_frame(&frame.shading);
+
+        if self.show == Show::Samples {
+            // Debug view: the sample points coloured by irradiance.
+            let debug = DebugConstants { view_projection, color_scale: Vec3::ONE.extend(2.0) };
+            let (points, n) = (&self.hierarchy.sorted_points, self.hierarchy.point_count);
+            self.ctx.submit(self.profiler.as_mut(), |rec| {
+                rec.scope("show samples", |rec| {
+                    self.passes.debug_view.record_points(rec, &self.color, &self.depth, points, n, &debug)
+                })
+            })?;
+        }
+        if let Show::Tree(level) = self.show {
+            // Debug only: the boxes come from a download of the nodes, drawn in a second submission.
+            let nodes = self.hierarchy.download(&self.ctx)?.nodes;
+            let lines = debug_view::tree_level_lines(&nodes, level);
+            if lines.is_empty() {
+                return Err(crate::bad_input!("--level {level}: the tree has no internal nodes that deep"));
+            }
+            let buffer = vk::upload_buffer(&self.ctx, "tree lines", &lines, BufferUsageFlags::VERTEX_BUFFER)?;
+            let debug = DebugConstants { view_projection, color_scale: Vec3::ONE.extend(1.0) };
+            self.ctx.submit(None, |rec| {
+                self.passes.debug_view.record_lines(rec, &self.color, &self.depth, &buffer, lines.len() as u32, &debug)
+            })?;
+        }
+        self.ctx.submit(self.profiler.as_mut(), |rec| {
+            // Exposure from a luminance histogram, the filmic curve and sRGB, packed to 8 bits.
+            rec.scope("tone mapping", |rec| {
+                self.passes.tonemap.record(rec, &self.color, &self.histogram, &self.ldr, self.exposure)
+            })?;
+            // The 8-bit image, the linear radiance and the work counters, for the host.
+            rec.scope("readback", |rec| {
+                rec.host_read(&self.work_counters)?;
+                rec.host_read(&self.ldr)?;
+                rec.copy_image_to_buffer(&self.color, &self.readback)
+            })
+        })?;
+        self.check_finite()?;
+        Ok(self.profiler.as_mut().map(|p| p.take_scopes()).unwrap_or_default())
+    }
+}
+
 /// The images and buffers whose size is the frame's.
 struct Targets {
     color: Image,
@@ -797,33 +793,5 @@ impl Targets {
             MemoryLocation::GpuToCpu,
         )?;
         Ok(Targets { color, depth, position, normal, readback, ldr })
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn submissions_grow_and_shrink_toward_the_target_time() {
-        assert_eq!(next_batch_size(1, 1e-6, SUBMISSION_TARGET_S), 2, "fast: at most doubles");
-        assert_eq!(
-            next_batch_size(200, 1e-6, SUBMISSION_TARGET_S),
-            MAX_UNITS_PER_SUBMISSION,
-            "never past the descriptor pool"
-        );
-        assert_eq!(next_batch_size(8, 0.1, SUBMISSION_TARGET_S), 16);
-        assert_eq!(next_batch_size(8, 0.8, SUBMISSION_TARGET_S), 2, "slow: shrinks to what fits");
-        assert_eq!(next_batch_size(1, 30.0, SUBMISSION_TARGET_S), 1, "never below one unit");
-        assert_eq!(next_batch_size(4, 0.0, SUBMISSION_TARGET_S), 8);
-    }
-
-    #[test]
-    fn fast_frames_are_shaded_whole() {
-        assert!(shade_whole_frame(false, 1, 0.01, SUBMISSION_TARGET_S), "one quick submission: one tile next time");
-        assert!(!shade_whole_frame(false, 2, 0.01, SUBMISSION_TARGET_S), "several submissions: keep the tiles");
-        assert!(!shade_whole_frame(false, 1, 0.1, SUBMISSION_TARGET_S), "not quick enough to risk a whole frame");
-        assert!(shade_whole_frame(true, 1, 0.15, SUBMISSION_TARGET_S), "stays whole while under the target");
-        assert!(!shade_whole_frame(true, 1, 0.5, SUBMISSION_TARGET_S), "back to tiles when a frame gets slow");
     }
 }

@@ -14,15 +14,11 @@ use crate::gpu::{
     GpuLight, LightSetHeader, NodeLight, PointLight, SurfacePoint, TreeNode, LEAF_BIT, MAX_LIGHTS, RADIX_TILE as TILE,
 };
 use crate::mesh::Mesh;
-use crate::passes::irradiance::IrradiancePass;
-use crate::passes::sampling::SamplingPass;
-use crate::passes::shadow::{self, ShadowPass};
-use crate::passes::sort::{SortBuffers, SortPass};
-use crate::passes::tree::{TreeBuffers, TreePass};
+use crate::passes::shadow;
+use crate::passes::sort::SortBuffers;
+use crate::passes::tree::TreeBuffers;
 use crate::scene::Light;
-use crate::vk::{
-    self, Buffer, BufferUsageFlags, Context, Extent2D, Image, ImageUsageFlags, MemoryLocation, Recorder, Sampler,
-};
+use crate::vk::{self, Buffer, BufferUsageFlags, Context, Extent2D, Image, ImageUsageFlags, MemoryLocation, Sampler};
 use crate::{bad_input, runtime};
 
 impl TreeNode {
@@ -112,21 +108,18 @@ pub fn bytes_used(n: u32, lights: u32) -> u64 {
     n as u64 * (BYTES_PER_POINT + lights as u64 * BYTES_PER_POINT_AND_LIGHT)
 }
 
+/// The hierarchy's buffers and images, and their sizes; the passes that fill them every frame are
+/// the renderer's (`HierarchyPasses` in src/frame.rs, which lists them in order).
 pub struct Hierarchy {
-    sampling: SamplingPass,
-    shadow: ShadowPass,
-    irradiance: IrradiancePass,
-    sort: SortPass,
-    tree: TreePass,
-    prefix: Buffer,
-    points: Buffer,
+    pub(crate) prefix: Buffer,
+    pub(crate) points: Buffer,
     keys: [Buffer; 2],
     values: [Buffer; 2],
     counts: Buffer,
     pub sorted_points: Buffer,
     pub nodes: Buffer,
     /// Each light's record of each point, [point · light_count + light], unsorted then sorted.
-    point_lights: Buffer,
+    pub(crate) point_lights: Buffer,
     pub sorted_point_lights: Buffer,
     /// Each light's record of each node, [node · light_count + light].
     pub node_lights: Buffer,
@@ -136,14 +129,14 @@ pub struct Hierarchy {
     pub lights: Buffer,
     pub shadow_map: Image,
     pub shadow_sampler: Sampler,
-    layer_matrices: Vec<Mat4>,
+    pub(crate) layer_matrices: Vec<Mat4>,
     eta: f32,
     shadow_resolution: u32,
     pub point_count: u32,
     /// Lights the per-light records were made for (at creation; later light sets may not exceed it).
     pub light_count: u32,
-    triangle_count: u32,
-    index_count: u32,
+    pub(crate) triangle_count: u32,
+    pub(crate) index_count: u32,
     bounds: (Vec3, Vec3),
     pub seed: u32,
 }
@@ -175,11 +168,6 @@ impl Hierarchy {
         let (lo, hi) = mesh.bounds();
         let pad = (hi - lo).max_element() * 1e-3;
         let mut h = Hierarchy {
-            sampling: SamplingPass::new(ctx)?,
-            shadow: ShadowPass::new(ctx)?,
-            irradiance: IrradiancePass::new(ctx)?,
-            sort: SortPass::new(ctx)?,
-            tree: TreePass::new(ctx)?,
             // The total area (f32 and padding), then N + 1 64-bit fixed-point sums.
             prefix: storage("triangle area prefix sum", 8 + (mesh.triangle_count() as u64 + 1) * 8)?,
             points: storage("points", n64 * 64)?,
@@ -272,30 +260,9 @@ impl Hierarchy {
         Ok(())
     }
 
-    /// Records every stage, each in its own timestamp scope.
-    pub fn record(&self, rec: &mut Recorder, vertices: &Buffer, indices: &Buffer) -> Result<()> {
-        let n = self.point_count;
-        rec.begin_scope("sampling");
-        self.sampling.record(rec, vertices, indices, self.triangle_count, &self.prefix, &self.points, n, self.seed)?;
-        rec.end_scope();
-
-        rec.begin_scope("shadow maps");
-        self.shadow.record(rec, vertices, indices, self.index_count, &self.shadow_map, &self.layer_matrices)?;
-        rec.end_scope();
-
-        rec.begin_scope("irradiance");
-        self.irradiance.record(
-            rec,
-            &self.points,
-            &self.point_lights,
-            n,
-            &self.lights,
-            &self.shadow_map,
-            &self.shadow_sampler,
-        )?;
-        rec.end_scope();
-
-        let sort_buffers = SortBuffers {
+    /// What the Morton and radix sort stages read and write.
+    pub(crate) fn sort_buffers(&self) -> SortBuffers<'_> {
+        SortBuffers {
             points: &self.points,
             keys: [&self.keys[0], &self.keys[1]],
             values: [&self.values[0], &self.values[1]],
@@ -304,15 +271,12 @@ impl Hierarchy {
             point_lights: &self.point_lights,
             sorted_point_lights: &self.sorted_point_lights,
             light_count: self.light_count,
-        };
-        rec.begin_scope("morton codes");
-        self.sort.record_morton(rec, &sort_buffers, n, self.bounds)?;
-        rec.end_scope();
-        rec.begin_scope("radix sort");
-        self.sort.record_sort(rec, &sort_buffers, n)?;
-        rec.end_scope();
+        }
+    }
 
-        let tree_buffers = TreeBuffers {
+    /// What the tree build and summary stages read and write.
+    pub(crate) fn tree_buffers(&self) -> TreeBuffers<'_> {
+        TreeBuffers {
             keys: &self.keys[0],
             sorted_points: &self.sorted_points,
             nodes: &self.nodes,
@@ -322,14 +286,7 @@ impl Hierarchy {
             sorted_point_lights: &self.sorted_point_lights,
             node_lights: &self.node_lights,
             light_count: self.light_count,
-        };
-        rec.begin_scope("tree build");
-        self.tree.record_build(rec, &tree_buffers, n)?;
-        rec.end_scope();
-        rec.begin_scope("tree summaries");
-        self.tree.record_aggregate(rec, &tree_buffers, n)?;
-        rec.end_scope();
-        Ok(())
+        }
     }
 
     /// Unsorted points, sorted keys, sort order, sorted points and nodes, for tests and tools.

@@ -1,6 +1,7 @@
 //! translucent: subsurface scattering with the directional dipole BSSRDF, integrated over a
 //! Jensen–Buhler hierarchy that the GPU rebuilds every frame.
 
+pub mod batching;
 pub mod bench;
 pub mod bssrdf_csv;
 pub mod budget;

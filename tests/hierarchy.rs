@@ -4,6 +4,7 @@ mod common;
 
 use common::{assert_clean, validated_context};
 use glam::{Vec3, Vec3Swizzles};
+use translucent::frame::HierarchyPasses;
 use translucent::gpu::{SurfacePoint, LEAF_BIT};
 use translucent::hierarchy::{reference_tree, Hierarchy, HierarchyOptions, Snapshot};
 use translucent::mesh::Mesh;
@@ -32,9 +33,10 @@ fn build(mesh: &Mesh, lights: &[Light], n: u32) -> Snapshot {
     let hierarchy =
         Hierarchy::new(&ctx, mesh, lights, &HierarchyOptions { point_count: n, shadow_resolution: 1024, eta: ETA })
             .unwrap();
-    ctx.submit(None, |rec| hierarchy.record(rec, &vertices, &indices)).unwrap();
+    let passes = HierarchyPasses::new(&ctx).unwrap();
+    ctx.submit(None, |rec| passes.record(rec, &hierarchy, &vertices, &indices)).unwrap();
     let snapshot = hierarchy.download(&ctx).unwrap();
-    drop((hierarchy, vertices, indices));
+    drop((passes, hierarchy, vertices, indices));
     drop(ctx);
     assert_clean(&counts);
     snapshot

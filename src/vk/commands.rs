@@ -511,6 +511,14 @@ impl<'a> Recorder<'a> {
         }
     }
 
+    /// Records `f` inside a named timestamp scope (see [`begin_scope`](Self::begin_scope)).
+    pub fn scope<T>(&mut self, name: &str, f: impl FnOnce(&mut Self) -> Result<T>) -> Result<T> {
+        self.begin_scope(name);
+        let t = f(self)?;
+        self.end_scope();
+        Ok(t)
+    }
+
     pub fn end_scope(&mut self) {
         let Some(index) = self.open_scopes.pop() else { return };
         if let Some(p) = self.profiler.as_deref_mut() {
