@@ -77,7 +77,7 @@ pub fn check_frame(ctx: &Context, s: &FrameSizes) -> Result<()> {
     let (w, h) = (s.width, s.height);
     let color_usage = ImageUsageFlags::COLOR_ATTACHMENT | ImageUsageFlags::TRANSFER_SRC | ImageUsageFlags::STORAGE;
     check_image(ctx, size, "colour", shade::COLOR_FORMAT, color_usage, (w, h, 1), 16)?;
-    check_image(ctx, size, "depth", shade::DEPTH_FORMAT, ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT, (w, h, 1), 8)?;
+    check_image(ctx, size, "depth", shade::DEPTH_FORMAT, ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT, (w, h, 1), 4)?;
     let surface_usage = ImageUsageFlags::COLOR_ATTACHMENT | ImageUsageFlags::STORAGE;
     check_image(ctx, size, "surface", shade::SURFACE_FORMAT, surface_usage, (w, h, 1), 16)?;
     let res = s.shadow_resolution;
@@ -88,7 +88,7 @@ pub fn check_frame(ctx: &Context, s: &FrameSizes) -> Result<()> {
     // Device memory: the frame's targets, the shadow maps and the hierarchy (host-visible
     // read-back buffers live in another heap on a discrete GPU and are left out).
     let parts = [
-        (size, w as u64 * h as u64 * (16 + 8 + 2 * 16)),
+        (size, w as u64 * h as u64 * (16 + 4 + 2 * 16)),
         ("--shadow-resolution", res as u64 * res as u64 * s.shadow_layers as u64 * 4),
         ("--samples", crate::hierarchy::bytes_used(s.point_count, s.light_count)),
     ];

@@ -28,7 +28,6 @@ impl DebugViewPass {
             color_formats: &[COLOR_FORMAT],
             depth_format: Some(DEPTH_FORMAT),
             depth_test: true,
-            depth_equal: false,
             depth_bias: false,
             cull_mode: CullModeFlags::NONE,
             additive_blend: false,

@@ -14,7 +14,7 @@ use crate::vk::{
 };
 
 pub const COLOR_FORMAT: Format = Format::R32G32B32A32_SFLOAT;
-pub const DEPTH_FORMAT: Format = Format::D32_SFLOAT_S8_UINT;
+pub const DEPTH_FORMAT: Format = Format::D32_SFLOAT;
 /// The G-buffer: world position (w = 1 where covered) and interpolated normal, f32 so that shading
 /// sees the values a fragment shader on the mesh would have.
 pub const SURFACE_FORMAT: Format = Format::R32G32B32A32_SFLOAT;
@@ -101,7 +101,6 @@ fn shading_pipeline(ctx: &Context, model: u32, additive_blend: bool) -> Result<P
             color_formats: &[COLOR_FORMAT],
             depth_format: None,
             depth_test: false,
-            depth_equal: false,
             depth_bias: false,
             cull_mode: CullModeFlags::NONE,
             additive_blend,
@@ -123,7 +122,6 @@ impl ShadePass {
                 color_formats: &[SURFACE_FORMAT, SURFACE_FORMAT],
                 depth_format: Some(DEPTH_FORMAT),
                 depth_test: true,
-                depth_equal: false,
                 depth_bias: false,
                 cull_mode: CullModeFlags::NONE,
                 additive_blend: false,

@@ -62,7 +62,6 @@ impl ShadowPass {
                 color_formats: &[],
                 depth_format: Some(SHADOW_FORMAT),
                 depth_test: true,
-                depth_equal: false,
                 depth_bias: true,
                 cull_mode: CullModeFlags::NONE,
                 additive_blend: false,

@@ -223,11 +223,6 @@ impl<'a> Recorder<'a> {
         unsafe { self.device().cmd_set_scissor(self.cmd, 0, &[rect]) };
     }
 
-    /// The stencil reference of pipelines that test it (see `GraphicsDesc::depth_equal`).
-    pub fn set_stencil_reference(&mut self, reference: u32) {
-        unsafe { self.device().cmd_set_stencil_reference(self.cmd, vk::StencilFaceFlags::FRONT_AND_BACK, reference) };
-    }
-
     pub fn set_depth_bias(&mut self, constant: f32, slope: f32) {
         unsafe { self.device().cmd_set_depth_bias(self.cmd, constant, 0.0, slope) };
     }

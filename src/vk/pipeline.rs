@@ -357,23 +357,9 @@ impl Pipeline {
             vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
         let depth = vk::PipelineDepthStencilStateCreateInfo::default()
             .depth_test_enable(desc.depth_format.is_some() && desc.depth_test)
-            .depth_write_enable(desc.depth_format.is_some() && desc.depth_test && !desc.depth_equal)
-            .depth_compare_op(if desc.depth_equal { vk::CompareOp::EQUAL } else { vk::CompareOp::LESS_OR_EQUAL });
-        // Shade each pixel once: of the fragments that pass the EQUAL depth test (coincident
-        // triangles all do), only the first in primitive order passes "stencil == reference",
-        // and it increments the stencil so that the rest fail, before the shader runs.
+            .depth_write_enable(desc.depth_format.is_some() && desc.depth_test)
+            .depth_compare_op(vk::CompareOp::LESS_OR_EQUAL);
         let stencil_format = desc.depth_format.filter(|&f| super::resources::has_stencil(f));
-        let once = desc.depth_equal && stencil_format.is_some();
-        let once_op = vk::StencilOpState {
-            fail_op: vk::StencilOp::KEEP,
-            pass_op: vk::StencilOp::INCREMENT_AND_WRAP,
-            depth_fail_op: vk::StencilOp::KEEP,
-            compare_op: vk::CompareOp::EQUAL,
-            compare_mask: 0xff,
-            write_mask: 0xff,
-            reference: 0,
-        };
-        let depth = if once { depth.stencil_test_enable(true).front(once_op).back(once_op) } else { depth };
         let blend_attachments: Vec<_> = desc
             .color_formats
             .iter()
@@ -397,9 +383,6 @@ impl Pipeline {
         let mut dynamic_states = vec![vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
         if desc.depth_bias {
             dynamic_states.push(vk::DynamicState::DEPTH_BIAS);
-        }
-        if once {
-            dynamic_states.push(vk::DynamicState::STENCIL_REFERENCE);
         }
         let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
         let mut rendering = vk::PipelineRenderingCreateInfo::default()
@@ -440,10 +423,6 @@ pub struct GraphicsDesc<'a> {
     pub color_formats: &'a [vk::Format],
     pub depth_format: Option<vk::Format>,
     pub depth_test: bool,
-    /// Test depth for equality without writing it (shading after a depth pre-pass). With a
-    /// depth format that has stencil, also shade each pixel once whatever the mesh: stencil
-    /// EQUAL to the dynamic reference (`Recorder::set_stencil_reference`), incremented on pass.
-    pub depth_equal: bool,
     pub depth_bias: bool,
     pub cull_mode: vk::CullModeFlags,
     pub additive_blend: bool,
