@@ -30,7 +30,7 @@ layout(push_constant) uniform TileCutConstants {
     uint light_count;
 } pc;
 
-const uint STACK_SIZE = 96u;
+const uint END = 0xffffffffu;
 
 // The squared distance from p to the box [lo, hi] (0 inside).
 float distance2_to_box(vec3 p, vec3 lo, vec3 hi) {
@@ -38,27 +38,43 @@ float distance2_to_box(vec3 p, vec3 lo, vec3 hi) {
     return dot(d, d);
 }
 
+// The subtree after the one whose last point is `last`, in depth-first order (left child
+// first): it starts at point last + 1, and in Karras's layout an internal node's range has the
+// node's own index at one end, so it is internal node last + 1 if that node's range starts
+// there, else the point itself. No stack: llvmpipe keeps a private array per lane, and the
+// walk's pushes and pops cost more than this one extra texel.
+uint next_after(uint last) {
+    uint next = last + 1u;
+    if (next >= params.point_count) return END;
+    if (next < params.node_count && texel(nodes, next * NODE_TEXELS + 3u).z == next) return next;
+    return next | LEAF_BIT;
+}
+
 // Counts (write = false) or writes (write = true, at `first`) the tile's list; returns the counts
 // of points, nodes and frontier entries.
 uvec3 walk(vec3 tile_lo, vec3 tile_hi, bool write, uint first, uvec3 counts) {
     float tile_extent2 = dot(tile_hi - tile_lo, tile_hi - tile_lo);
     uvec3 n = uvec3(0u);
-    uint stack[STACK_SIZE];
-    uint top = 0u;
-    stack[top++] = 0u;
+    uint item = 0u; // the root
     uint steps = 0u;
-    while (top > 0u) {
-        uint item = stack[--top];
+    while (item != END) {
         ++steps;
         uint index = item & ~LEAF_BIT;
         if ((item & LEAF_BIT) != 0u) {
-            if (texel_float(points, index * POINT_TEXELS + 2u).xyz == vec3(0.0)) continue;
-            if (write) entries[first + n.x] = index;
-            ++n.x;
+            if (texel_float(points, index * POINT_TEXELS + 2u).xyz != vec3(0.0)) {
+                if (write) entries[first + n.x] = index;
+                ++n.x;
+            }
+            item = next_after(index);
             continue;
         }
         vec4 power_area = texel_float(nodes, index * NODE_TEXELS);
-        if (power_area.xyz == vec3(0.0)) continue;
+        uvec4 range = texel(nodes, index * NODE_TEXELS + 3u);
+        uint after = next_after(range.z + range.w - 1u);
+        if (power_area.xyz == vec3(0.0)) {
+            item = after;
+            continue;
+        }
         uvec4 center_left = texel(nodes, index * NODE_TEXELS + 1u);
         uvec4 box_right = texel(nodes, index * NODE_TEXELS + 2u);
         vec3 lo, hi;
@@ -66,20 +82,22 @@ uvec3 walk(vec3 tile_lo, vec3 tile_hi, bool write, uint first, uvec3 counts) {
         bool overlaps = all(lessThanEqual(lo, tile_hi)) && all(lessThanEqual(tile_lo, hi));
         float d2 = distance2_to_box(uintBitsToFloat(center_left.xyz), tile_lo, tile_hi);
         bool whole = !overlaps && power_area.w < params.epsilon * d2;
-        // Budgets: the stack, and the list's evaluations against llvmpipe's loop budget (the
-        // shade pass loops over them); past them a node is used whole, as the pixel walk does.
+        // Budgets: the list's evaluations against llvmpipe's loop budget (the shade pass loops
+        // over them), and this walk's steps; past them a node is used whole, as the pixel walk
+        // does.
         uint evaluations = (n.x + 2u * n.y) * pc.light_count;
-        bool must_stop = top + 2u > STACK_SIZE || steps > MAX_CUT_STEPS || evaluations > MAX_LIST_EVALUATIONS;
+        bool must_stop = steps > MAX_CUT_STEPS || evaluations > MAX_LIST_EVALUATIONS;
         if (whole || must_stop) {
             if (write) entries[first + counts.x + n.y] = index;
             ++n.y;
+            item = after;
         } else if (dot(hi - lo, hi - lo) * 4.0 < tile_extent2) {
             // Small beside the tile: pixels differ on how to cut it, so each walks it.
             if (write) entries[first + counts.x + counts.y + n.z] = index;
             ++n.z;
+            item = after;
         } else {
-            stack[top++] = center_left.w;
-            stack[top++] = box_right.w;
+            item = center_left.w; // open it: its left child next
         }
     }
     return n;
