@@ -67,14 +67,7 @@ fn csv_header() -> String {
 const GOOD_ROW: &str = "0.01,1,0,1.3,0,0,0,0,0,1,0,0,1,1,0,0,0,0,1";
 
 fn bssrdf(args: &[&str], input: Vec<u8>) -> Output {
-    let mut child = bin()
-        .arg("bssrdf")
-        .args(args)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
+    let mut child = common::spawn_bssrdf(args);
     let mut stdin = child.stdin.take().unwrap();
     let writer = std::thread::spawn(move || stdin.write_all(&input));
     let out = child.wait_with_output().unwrap();
@@ -200,14 +193,7 @@ fn class4_bssrdf_writes_output_before_the_input_ends() {
 
 fn bssrdf_streams(args: &[&str]) {
     let rows = translucent::bssrdf_csv::BATCH_ROWS + 10;
-    let mut child = bin()
-        .arg("bssrdf")
-        .args(args)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
+    let mut child = common::spawn_bssrdf(args);
     let mut stdin = child.stdin.take().unwrap();
     let mut input = csv_header() + "\n";
     for _ in 0..rows {

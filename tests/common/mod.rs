@@ -67,6 +67,18 @@ pub fn translucent(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_translucent")).args(args).output().expect("run translucent")
 }
 
+/// Starts `translucent bssrdf ARGS` with piped stdin, stdout and stderr.
+pub fn spawn_bssrdf(args: &[&str]) -> std::process::Child {
+    Command::new(env!("CARGO_BIN_EXE_translucent"))
+        .arg("bssrdf")
+        .args(args)
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("start translucent bssrdf")
+}
+
 /// Where tests write images (actual and difference images on failure).
 pub fn output_dir() -> PathBuf {
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("translucent-tests");
