@@ -1,9 +1,10 @@
 #version 460
-// Subsurface scattering per pixel, in a full-screen pass over the G-buffer of the surface pass:
-// walks the Jensen–Buhler tree from the root with an explicit stack; a node far and small enough
-// (area / distance² from its area centre < epsilon, and xo outside its box) is used whole: two
-// sigma points per light; otherwise its children are visited; points are evaluated singly, one
-// source per light.
+// Subsurface scattering per pixel, in a full-screen pass over the G-buffer of the surface pass.
+// The pixel's sources come from its tile's list (tile_cut.comp): nodes used whole for the whole
+// tile (two sigma points per light), points evaluated singly (one source per light), and frontier
+// nodes that this pixel walks on its own (a node far and small enough from xo, area / distance²
+// < epsilon and xo outside its box, is used whole, else its children are visited). A tile whose
+// list did not fit, and brute force, sum from the root or over every point instead.
 // Lo(xo, wo) = Ft(eta, wo) · Σ over sources and lights Sd(xi, wi_k; xo, no) · power_k, power = E·A
 // (mm²), plus the surface's own reflection from each light: a microfacet lobe, shadowed by the
 // same shadow maps. Which nodes are used whole does not depend on the lights, and each term
@@ -11,7 +12,7 @@
 #include "common.glsl"
 #include "shade_constants.glsl"
 #include "points.glsl"
-#include "subsurface_params.glsl"
+#include "shading_params.glsl"
 #include "lights.glsl"
 #include "microfacet.glsl"
 #include "tile_lists.glsl"
@@ -24,7 +25,7 @@ layout(constant_id = 0) const uint MODEL = 0u; // 0 directional dipole, 1 classi
 layout(location = 0) out vec4 radiance;
 
 // A uniform buffer: llvmpipe loads its members once per SIMD group (storage buffers per lane).
-layout(std140, binding = 0) uniform Params { SubsurfaceParams params; };
+layout(std140, binding = 0) uniform Object { ObjectParams object_params; };
 // The tree's records as texels (see points.glsl): TreeNode, SurfacePoint (sorted).
 layout(binding = 1) uniform usamplerBuffer nodes;
 layout(binding = 2) uniform usamplerBuffer points;
@@ -44,6 +45,7 @@ layout(binding = 10) uniform usamplerBuffer tile_headers;
 layout(binding = 11) uniform usamplerBuffer tile_entries;
 // The classical dipole's Sd per channel, tabulated (bssrdf.glsl).
 layout(binding = 12) uniform usamplerBuffer dipole_table;
+layout(std140, binding = 13) uniform Frame { FrameParams frame_params; };
 vec4 dipole_header; // its texel 0, read once per pixel
 
 const uint STACK_SIZE = 96u;
@@ -56,16 +58,16 @@ const uint EVALUATION_MASK = 0x1fu;
 const uint MAX_STEPS = 32768u;
 
 vec3 source(vec3 xi, vec3 ni, vec3 wi, vec3 power, vec3 xo, vec3 no) {
-    float s = params.mm_per_unit;
+    float s = object_params.mm_per_unit;
     vec3 sd;
     // Written out, not looped: loop iterations count against llvmpipe's budget (see main).
     if (MODEL == MODEL_DIRECTIONAL) {
         // The geometry once for all three channels (they share eta).
         vec3 xi_mm = xi * s, xo_mm = xo * s;
-        DirpoleGeometry g = dirpole_geometry(xi_mm, ni, wi, xo_mm, no, params.channels[0].eta);
-        sd = vec3(dirpole_channel_sd(params.channels[0], g, xi_mm, xo_mm, no),
-                  dirpole_channel_sd(params.channels[1], g, xi_mm, xo_mm, no),
-                  dirpole_channel_sd(params.channels[2], g, xi_mm, xo_mm, no));
+        DirpoleGeometry g = dirpole_geometry(xi_mm, ni, wi, xo_mm, no, object_params.channels[0].eta);
+        sd = vec3(dirpole_channel_sd(object_params.channels[0], g, xi_mm, xo_mm, no),
+                  dirpole_channel_sd(object_params.channels[1], g, xi_mm, xo_mm, no),
+                  dirpole_channel_sd(object_params.channels[2], g, xi_mm, xo_mm, no));
     } else {
         sd = dipole_sd_table(dipole_table, dipole_header, length(xo - xi) * s);
     }
@@ -120,7 +122,7 @@ vec3 specular(vec3 xo, vec3 no, vec3 wo) {
         vec3 toward;
         uint layer;
         vec3 incident = light_at(light_set.lights[k], xo, toward, layer);
-        float f_cos = microfacet_reflect_cos(no, toward, wo, params.roughness, params.channels[0].eta);
+        float f_cos = microfacet_reflect_cos(no, toward, wo, frame_params.roughness, object_params.channels[0].eta);
         if (f_cos <= 0.0) continue;
         vec4 clip = layer_matrices[layer] * vec4(xo + no * light_set.normal_offset, 1.0);
         vec3 ndc = clip.xyz / clip.w;
@@ -147,11 +149,11 @@ void main() {
     uint evaluated = 0u;
     uint evaluations = 0u;
     uint light_count = light_set.light_count;
-    if (params.brute_force != 0u || params.node_count == 0u) {
+    if (frame_params.brute_force != 0u || object_params.node_count == 0u) {
         // One draw per range of (point, light) records, added by blending: llvmpipe (lavapipe)
         // silently ends a shader invocation's loops after ~65k iterations in total, so no draw
         // may loop longer.
-        uint end = min(pc.point_range.x + pc.point_range.y, params.point_count * light_count);
+        uint end = min(pc.point_range.x + pc.point_range.y, object_params.point_count * light_count);
         for (uint r = pc.point_range.x; r < end; ++r) sum += point_light_source(r, light_count, xo, no);
         evaluated = end > pc.point_range.x ? end - pc.point_range.x : 0u;
         evaluations = evaluated;
@@ -235,7 +237,7 @@ void main() {
                         // node is then used whole, an approximation rather than a silently
                         // truncated sum.
                         bool must_stop = top + 2u > STACK_SIZE || steps > MAX_STEPS;
-                        if (inside || power_area.w >= params.epsilon * dot(d, d)) {
+                        if (inside || power_area.w >= frame_params.epsilon * dot(d, d)) {
                             if (!must_stop) {
                                 stack[top++] = center_left.w;
                                 stack[top++] = box_right.w;
@@ -264,23 +266,23 @@ void main() {
         }
     }
     // Helper invocations' atomics have no effect (Vulkan spec), so only real pixels count.
-    if (params.count_work != 0u) {
+    if (frame_params.count_work != 0u) {
         // Brute-force draws after the first add their points only.
-        bool brute_force = params.brute_force != 0u || params.node_count == 0u;
+        bool brute_force = frame_params.brute_force != 0u || object_params.node_count == 0u;
         if (pc.point_range.x == 0u) {
             atomicAdd(work.pixels, 1u);
             atomicAdd(work.node_sum, visits);
             atomicMax(work.node_max, visits);
             // A brute-force pixel's points span several draws: its maximum is all of them (the
             // measured sum over the draws checks it).
-            atomicMax(work.point_max, brute_force ? params.point_count * light_count : evaluated);
+            atomicMax(work.point_max, brute_force ? object_params.point_count * light_count : evaluated);
         }
         atomicAdd(work.point_sum, evaluated);
         atomicAdd(work.evaluation_sum, evaluations);
     }
     float cos_o = max(dot(no, wo), 0.0);
-    vec3 lo = fresnel_transmittance(params.channels[0].eta, cos_o) * sum;
+    vec3 lo = fresnel_transmittance(object_params.channels[0].eta, cos_o) * sum;
     // The lobe is added once: by the first of several brute-force draws.
-    if (params.specular != 0u && pc.point_range.x == 0u) lo += specular(xo, no, wo);
+    if (frame_params.specular != 0u && pc.point_range.x == 0u) lo += specular(xo, no, wo);
     radiance = vec4(lo, 1.0);
 }

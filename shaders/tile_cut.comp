@@ -11,18 +11,19 @@
 // one atomic allocation in the list buffer, to write; a tile whose list does not fit is marked
 // for a walk from the root per pixel (the host then grows the buffer for the next try).
 #include "points.glsl"
-#include "subsurface_params.glsl"
+#include "shading_params.glsl"
 #include "tile_lists.glsl"
 // One SIMD group of llvmpipe per work group; a row of tiles per dispatch row.
 layout(local_size_x = 8) in;
 
-layout(std140, binding = 0) uniform Params { SubsurfaceParams params; };
+layout(std140, binding = 0) uniform Object { ObjectParams object_params; };
 layout(binding = 1) uniform usamplerBuffer nodes;
 layout(binding = 2) uniform usamplerBuffer points;
 layout(binding = 3, rgba32f) uniform readonly image2D surface_position;
 layout(std430, binding = 4) writeonly buffer Headers { uvec4 headers[]; };
 layout(std430, binding = 5) writeonly buffer Entries { uint entries[]; };
 layout(std430, binding = 6) buffer Allocation { uint allocated; } allocation;
+layout(std140, binding = 7) uniform Frame { FrameParams frame_params; };
 layout(push_constant) uniform TileCutConstants {
     uvec2 tiles;      // tiles across and down
     uvec2 pixels;     // image width and height
@@ -45,8 +46,8 @@ float distance2_to_box(vec3 p, vec3 lo, vec3 hi) {
 // walk's pushes and pops cost more than this one extra texel.
 uint next_after(uint last) {
     uint next = last + 1u;
-    if (next >= params.point_count) return END;
-    if (next < params.node_count && texel(nodes, next * NODE_TEXELS + 3u).z == next) return next;
+    if (next >= object_params.point_count) return END;
+    if (next < object_params.node_count && texel(nodes, next * NODE_TEXELS + 3u).z == next) return next;
     return next | LEAF_BIT;
 }
 
@@ -81,7 +82,7 @@ uvec3 walk(vec3 tile_lo, vec3 tile_hi, bool write, uint first, uvec3 counts) {
         unpack_box(box_right.xyz, lo, hi);
         bool overlaps = all(lessThanEqual(lo, tile_hi)) && all(lessThanEqual(tile_lo, hi));
         float d2 = distance2_to_box(uintBitsToFloat(center_left.xyz), tile_lo, tile_hi);
-        bool whole = !overlaps && power_area.w < params.epsilon * d2;
+        bool whole = !overlaps && power_area.w < frame_params.epsilon * d2;
         // Budgets: the list's evaluations against llvmpipe's loop budget (the shade pass loops
         // over them), and this walk's steps; past them a node is used whole, as the pixel walk
         // does.
@@ -121,7 +122,7 @@ void main() {
             covered = true;
         }
     }
-    if (!covered || params.node_count == 0u) {
+    if (!covered || object_params.node_count == 0u) {
         headers[tile] = uvec4(0u);
         return;
     }

@@ -9,12 +9,13 @@
 use glam::Vec3;
 
 use crate::error::Result;
-use crate::frame::{Renderer, DEFAULT_EPSILON};
+use crate::frame::Renderer;
+use crate::frame_desc::{Integration, DEFAULT_EPSILON};
 use crate::gpu::WorkCounters;
 use crate::hierarchy;
 use crate::mesh::Mesh;
 use crate::output::{relative_rmse, HdrImage};
-use crate::profiling::{summary, PassStats, ProfileReport, Scope};
+use crate::profiling::{summary, PassStats, ProfileReport};
 use crate::scene::{bounding_sphere, Camera, Light, Scene};
 use crate::settings::RenderSettings;
 use crate::vk::{Context, ContextOptions};
@@ -127,21 +128,17 @@ fn run_with(
 ) -> Result<Run> {
     let ctx = Context::new(context)?;
     let device = format!("{} ({})", ctx.info.name, ctx.info.driver);
-    let mut settings = RenderSettings::new(scene.clone(), material.clone());
-    settings.subsurface.model = model;
-    (settings.subsurface.epsilon, settings.subsurface.brute_force, settings.subsurface.specular) =
-        (epsilon, brute_force, specular);
-    (settings.width, settings.height, settings.samples, settings.count_work) = (size.0, size.1, Some(n), true);
-    let options = settings.frame_options(settings.point_count(&ctx)?);
-    let mut renderer = Renderer::new(ctx, scene, options)?;
+    let RenderSettings { mut world, mut desc, profile } = RenderSettings::new(scene.clone(), material.clone());
+    world.objects[0].samples = Some(n);
+    desc.integration = Integration { model, epsilon, brute_force, ..desc.integration };
+    (desc.specular, desc.width, desc.height, desc.count_work) = (specular, size.0, size.1, true);
+    let mut renderer = Renderer::new(ctx, profile)?;
     let mut timed = Vec::new();
     for _ in 0..frames.max(2) {
-        let scopes = renderer.render_frame(scene)?;
-        timed
-            .push(scopes.into_iter().map(|s| Scope { name: s.name, begin_ns: s.begin_ns, end_ns: s.end_ns }).collect());
+        timed.push(renderer.render_frame(&world, &desc)?);
     }
     timed.remove(0);
-    let passes = summary(&ProfileReport { device: device.clone(), frames: timed });
+    let passes = summary(&ProfileReport::from_frames(&device, timed));
     Ok(Run { device, passes, work: renderer.work()?, image: renderer.image()? })
 }
 

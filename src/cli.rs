@@ -9,6 +9,7 @@ use glam::Vec3;
 use crate::mesh::safe_normalize;
 use crate::physics::{Diffusion, Model};
 use crate::scene::Light;
+use crate::vk::PresentMode;
 
 #[derive(Parser, Debug)]
 #[command(name = "translucent", version, about = "Subsurface scattering with the directional dipole on Vulkan")]
@@ -32,7 +33,46 @@ pub enum Command {
     /// Time every pass (GPU timestamps) for several sample counts and meshes; prints Markdown.
     Bench(BenchArgs),
     /// Show the scene in a window: orbit camera, light and material edits, scripted runs.
-    View(Box<crate::view::ViewArgs>),
+    View(Box<ViewArgs>),
+}
+
+#[derive(Args, Debug)]
+pub struct ViewArgs {
+    #[command(flatten)]
+    pub render: RenderArgs,
+    /// How frames wait for the screen: fifo (vertical blank; always offered), fifo-relaxed,
+    /// mailbox, immediate.
+    #[arg(long, value_enum, default_value = "fifo")]
+    pub present_mode: PresentModeArg,
+    /// Write the last presented image (PNG) when the viewer exits.
+    #[arg(long, value_name = "FILE.png")]
+    pub screenshot: Option<PathBuf>,
+    /// Leave out the panel (settings and timings drawn over the image; `h` toggles it).
+    #[arg(long)]
+    pub no_panel: bool,
+    /// Run the commands of this file, one per line (orbit, pan, zoom, light, material, set,
+    /// frames, screenshot, resize, pause, trace, quit; see README "View").
+    #[arg(long, value_name = "FILE")]
+    pub script: Option<PathBuf>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum PresentModeArg {
+    Fifo,
+    FifoRelaxed,
+    Mailbox,
+    Immediate,
+}
+
+impl From<PresentModeArg> for PresentMode {
+    fn from(m: PresentModeArg) -> PresentMode {
+        match m {
+            PresentModeArg::Fifo => PresentMode::Fifo,
+            PresentModeArg::FifoRelaxed => PresentMode::FifoRelaxed,
+            PresentModeArg::Mailbox => PresentMode::Mailbox,
+            PresentModeArg::Immediate => PresentMode::Immediate,
+        }
+    }
 }
 
 #[derive(Args, Debug)]
@@ -74,19 +114,11 @@ pub enum ShowArg {
     Tree,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum ModelArg {
-    Directional,
-    Dipole,
-}
-
-impl From<ModelArg> for Model {
-    fn from(m: ModelArg) -> Model {
-        match m {
-            ModelArg::Directional => Model::Directional,
-            ModelArg::Dipole => Model::Dipole,
-        }
-    }
+/// `--model NAME`: a model registered in src/models.rs.
+fn model_arg() -> impl clap::builder::TypedValueParser<Value = Model> {
+    use clap::builder::TypedValueParser;
+    let names: Vec<&'static str> = crate::models::MODELS.iter().map(|e| e.name).collect();
+    clap::builder::PossibleValuesParser::new(names).map(|name| Model::from_name(&name).unwrap_or_default())
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -108,8 +140,8 @@ impl From<DiffusionArg> for Diffusion {
 
 #[derive(Args, Debug)]
 pub struct BssrdfArgs {
-    #[arg(long, value_enum, default_value = "directional")]
-    pub model: ModelArg,
+    #[arg(long, value_parser = model_arg(), default_value = "directional")]
+    pub model: Model,
     #[arg(long, value_enum, default_value = "classical")]
     pub diffusion: DiffusionArg,
     /// Evaluate in a compute shader through the GLSL include instead of the Rust code.
@@ -144,8 +176,8 @@ pub struct ProfileArgs {
     #[command(flatten)]
     pub material: MaterialArgs,
     /// Models to plot.
-    #[arg(long, value_enum, value_delimiter = ',', default_values = ["directional", "dipole"])]
-    pub model: Vec<ModelArg>,
+    #[arg(long, value_parser = model_arg(), value_delimiter = ',', default_values = ["directional", "dipole"])]
+    pub model: Vec<Model>,
     /// Angles of incidence in degrees, from the normal.
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true, default_values = ["0", "60"])]
     pub angles: Vec<f64>,
@@ -238,7 +270,7 @@ pub struct RenderArgs {
     #[arg(long, allow_hyphen_values = true, value_parser = clap::value_parser!(u32))]
     pub samples: Option<u32>,
     /// Shadow-map resolution per light (per cube face for point lights).
-    #[arg(long, allow_hyphen_values = true, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(16..=8192))]
+    #[arg(long, allow_hyphen_values = true, default_value_t = crate::frame_desc::DEFAULT_SHADOW_RESOLUTION, value_parser = clap::value_parser!(u32).range(16..=8192))]
     pub shadow_resolution: u32,
     /// Draw a debug view over the mesh: the sample points or the tree's boxes at --level.
     #[arg(long, value_enum, default_value = "shading")]
@@ -249,15 +281,15 @@ pub struct RenderArgs {
     #[command(flatten)]
     pub material: MaterialArgs,
     /// BSSRDF model.
-    #[arg(long, value_enum, default_value = "directional")]
-    pub model: ModelArg,
+    #[arg(long, value_parser = model_arg(), default_value = "directional")]
+    pub model: Model,
     #[arg(long, value_enum, default_value = "classical")]
     pub diffusion: DiffusionArg,
     /// Use a tree node whole (two sigma points per light) when its area / squared distance is below
     /// this. Measured against brute force (`translucent bench`, back-lit bunny, 16k points):
     /// relative RMSE 1.9% at 0.4, 0.95% at 0.2, 0.56% at 0.1, 0.28% at 0.05, with no bias; the
     /// shading time grows about 1.7× per halving.
-    #[arg(long, allow_hyphen_values = true, default_value_t = crate::frame::DEFAULT_EPSILON, value_parser = finite_f32)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = crate::frame_desc::DEFAULT_EPSILON, value_parser = finite_f32)]
     pub epsilon: f32,
     /// Visit every sample point for every pixel (the reference for the tree).
     #[arg(long)]
@@ -266,7 +298,7 @@ pub struct RenderArgs {
     #[arg(long)]
     pub no_specular: bool,
     /// Roughness of the microfacet reflection, in (0, 1] (GGX α = roughness²).
-    #[arg(long, allow_hyphen_values = true, default_value_t = crate::settings::DEFAULT_ROUGHNESS, value_parser = finite_f32)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = crate::frame_desc::DEFAULT_ROUGHNESS, value_parser = finite_f32)]
     pub roughness: f32,
     /// Exposure in stops (default: automatic from the image).
     #[arg(long, allow_hyphen_values = true, value_parser = finite_f32)]
@@ -287,7 +319,7 @@ fn any_f64(s: &str) -> std::result::Result<f64, String> {
     s.trim().parse().map_err(|_| format!("'{s}' is not a number"))
 }
 
-fn triple(s: &str) -> std::result::Result<[f64; 3], String> {
+pub(crate) fn triple(s: &str) -> std::result::Result<[f64; 3], String> {
     let v: Vec<f64> = s.split(',').map(any_f64).collect::<std::result::Result<_, _>>()?;
     match v.as_slice() {
         [x] => Ok([*x; 3]),
@@ -314,7 +346,7 @@ pub(crate) fn light_spec(s: &str) -> std::result::Result<Light, String> {
     Ok(light)
 }
 
-fn finite_f32(s: &str) -> std::result::Result<f32, String> {
+pub(crate) fn finite_f32(s: &str) -> std::result::Result<f32, String> {
     let v: f32 = s.trim().parse().map_err(|_| format!("'{s}' is not a number"))?;
     if !v.is_finite() {
         return Err(format!("'{s}' is not finite"));

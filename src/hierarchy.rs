@@ -13,7 +13,10 @@ use crate::error::Result;
 use crate::gpu::{
     GpuLight, LightSetHeader, NodeLight, PointLight, SurfacePoint, TreeNode, LEAF_BIT, MAX_LIGHTS, RADIX_TILE as TILE,
 };
+use crate::materials::Material;
 use crate::mesh::Mesh;
+use crate::physics::Diffusion;
+use crate::passes::sampling::prefix_bytes;
 use crate::passes::shadow;
 use crate::passes::sort::SortBuffers;
 use crate::passes::tree::TreeBuffers;
@@ -168,8 +171,7 @@ impl Hierarchy {
         let (lo, hi) = mesh.bounds();
         let pad = (hi - lo).max_element() * 1e-3;
         let mut h = Hierarchy {
-            // The total area (f32 and padding), then N + 1 64-bit fixed-point sums.
-            prefix: storage("triangle area prefix sum", 8 + (mesh.triangle_count() as u64 + 1) * 8)?,
+            prefix: storage("triangle area prefix sum", prefix_bytes(mesh.triangle_count() as u32))?,
             points: storage("points", n64 * 64)?,
             keys: [storage("morton keys A", n64 * 8)?, storage("morton keys B", n64 * 8)?],
             values: [storage("sort order A", n64 * 4)?, storage("sort order B", n64 * 4)?],
@@ -323,10 +325,12 @@ impl Hierarchy {
     pub fn set_mesh(&mut self, ctx: &Context, mesh: &Mesh, lights: &[Light]) -> Result<()> {
         let triangles = mesh.triangle_count() as u32;
         if triangles != self.triangle_count {
+            // The same size as `new` makes (it once allocated a quarter of it: frames after a
+            // change of topology sampled garbage).
             self.prefix = Buffer::new(
                 ctx,
                 "triangle area prefix sum",
-                (triangles as u64 + 1) * 4,
+                prefix_bytes(triangles),
                 BufferUsageFlags::STORAGE_BUFFER | BufferUsageFlags::TRANSFER_SRC | BufferUsageFlags::TRANSFER_DST,
                 MemoryLocation::GpuOnly,
             )?;
@@ -491,4 +495,26 @@ pub fn choose_point_count(surface_area: f32, shortest_length: f32, budget: u32) 
     let wanted = (surface_area / (spacing * spacing)).ceil();
     let n = if wanted.is_finite() { (wanted as u64).clamp(4096, budget as u64) as u32 } else { budget };
     (n, (surface_area / n as f32).sqrt())
+}
+
+/// Sample count from the material's shortest length scale (mean free path 1/σ't or diffusion
+/// length 1/σtr) and the mesh's area (in mm), within the device's budget for `lights` lights;
+/// prints the choice and warns when points are farther apart than that length.
+pub fn default_point_count(ctx: &Context, mesh: &Mesh, mm_per_unit: f32, material: &Material, lights: u32) -> u32 {
+    let mm = mm_per_unit;
+    let area_mm2 = mesh.surface_area() * mm * mm;
+    let shortest = (0..3)
+        .map(|ch| material.channel(ch).constants(Diffusion::Classical))
+        .filter(|c| c.transports && c.sigma_tr > 0.0)
+        .map(|c| (1.0 / c.sigma_tr).min(1.0 / c.sigma_t_reduced))
+        .fold(f64::INFINITY, f64::min) as f32;
+    let budget = max_points(ctx, lights).min(1 << 18);
+    let (n, spacing) = choose_point_count(area_mm2, shortest, budget);
+    crate::note!(
+        "samples: {n} points, {spacing:.3} mm apart on {area_mm2:.0} mm² (shortest of mean free path and diffusion length: {shortest:.3} mm)"
+    );
+    if spacing > shortest {
+        crate::note!("warning: points are spaced wider than the mean free path or diffusion length; raise --samples for accuracy");
+    }
+    n
 }

@@ -9,7 +9,7 @@ use glam::Vec3;
 use crate::bad_input;
 use crate::error::Result;
 
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Mesh {
     pub positions: Vec<Vec3>,
     pub normals: Vec<Vec3>,

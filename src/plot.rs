@@ -104,10 +104,7 @@ impl ProfileSpec {
 }
 
 fn model_name(m: Model) -> &'static str {
-    match m {
-        Model::Directional => "directional",
-        Model::Dipole => "dipole",
-    }
+    m.name()
 }
 
 /// Writes the plot by extension: `.png`, `.svg` or `.csv`.

@@ -17,6 +17,17 @@ pub struct ProfileReport {
     pub frames: Vec<Vec<Scope>>,
 }
 
+impl ProfileReport {
+    /// The report of `frames` as the renderer timed them on `device`.
+    pub fn from_frames(device: &str, frames: Vec<Vec<crate::vk::TimedScope>>) -> ProfileReport {
+        let scope = |s: crate::vk::TimedScope| Scope { name: s.name, begin_ns: s.begin_ns, end_ns: s.end_ns };
+        ProfileReport {
+            device: device.to_string(),
+            frames: frames.into_iter().map(|f| f.into_iter().map(scope).collect()).collect(),
+        }
+    }
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct PassStats {
     pub name: String,

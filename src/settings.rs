@@ -1,43 +1,23 @@
 //! What a frame is made from, whoever asks for it: `render` and `view` (from their flags, see
 //! [`RenderSettings::from_args`]), `bench` and the tests (from code). One builder turns settings
-//! into the scene and the renderer's [`FrameOptions`], so that every caller derives the same
-//! values the same way (η from the material, the default sample count, the checks).
+//! into a [`World`] and a [`FrameDesc`], so that every caller derives the same values the same
+//! way (the mesh's framing and scale, the lights, the material's overrides, the checks).
 
 use glam::Vec3;
 
 use crate::bad_input;
 use crate::cli::{DeviceArgs, MaterialArgs, RenderArgs, ShowArg};
 use crate::error::Result;
-use crate::frame::{FrameOptions, Show, SubsurfaceOptions, DEFAULT_EPSILON};
-use crate::hierarchy::HierarchyOptions;
+use crate::frame_desc::{check_roughness, FrameDesc, Integration, Show};
 use crate::materials::Material;
 use crate::mesh::safe_normalize;
 use crate::output::Exposure;
-use crate::physics::{Diffusion, Model};
 use crate::scene::{Camera, Light, Scene};
-use crate::vk::{Context, ContextOptions};
-
-/// The sizes (mm across) a mesh may have once --scale is applied: from a micrometre to a thousand
-/// kilometres, so that areas in mm² and the powers summed over them stay finite in f32.
-pub const SIZE_MM_LIMITS: (f64, f64) = (1e-3, 1e9);
-
-/// The largest coordinate accepted for --eye, --target and point lights: squared distances must
-/// stay finite in f32.
-pub const MAX_COORDINATE: f32 = 1e15;
+use crate::vk::ContextOptions;
+use crate::world::World;
 
 /// The Stanford bunny of Debian's glmark2-data, the default mesh when installed.
 pub const BUNNY: &str = "/usr/share/glmark2/models/bunny.obj";
-
-/// The default roughness of the microfacet reflection (`--roughness`).
-pub const DEFAULT_ROUGHNESS: f32 = 0.35;
-
-/// Refuses a roughness outside (0, 1]; `what` names it in the message (`--roughness`, `roughness`).
-pub fn check_roughness(roughness: f32, what: &str) -> Result<()> {
-    if !(roughness > 0.0 && roughness <= 1.0) {
-        return Err(bad_input!("{what} {roughness}: must be in (0, 1]"));
-    }
-    Ok(())
-}
 
 impl MaterialArgs {
     /// The preset with the coefficients given overridden, validated; prints the material's warning.
@@ -133,26 +113,13 @@ impl SceneSettings {
     pub fn build(&self) -> Result<Scene> {
         let mesh = crate::deform::first_mesh(&self.mesh_spec())?;
         let (centre, radius) = crate::scene::bounding_sphere(&mesh.positions);
-        // The object's size in millimetres must stay where f32 areas and powers are finite.
-        let size_mm = 2.0 * radius as f64 * self.scale as f64;
-        if !(SIZE_MM_LIMITS.0..=SIZE_MM_LIMITS.1).contains(&size_mm) {
-            return Err(bad_input!(
-                "--scale {}: the mesh would be {size_mm:.3e} mm across; it must be within [{:e}, {:e}] mm",
-                self.scale,
-                SIZE_MM_LIMITS.0,
-                SIZE_MM_LIMITS.1
-            ));
-        }
+        // The scale, the mesh and its size in millimetres, before anything is derived from them.
+        crate::world::check_geometry(&mesh, self.scale)?;
         let mut camera = Camera::framing(centre, radius, self.fov, Vec3::new(0.3, 0.3, 1.0));
         // Directions are normalised here, safely: (1e20, 1e20, 0) is a fine direction whose squared
         // length overflows f32, and would otherwise turn into NaN on the GPU.
         camera.up =
             safe_normalize(self.up).ok_or_else(|| bad_input!("--up {}: must be finite and non-zero", self.up))?;
-        for (flag, p) in [("--eye", self.eye), ("--target", self.target)] {
-            if let Some(p) = p.filter(|p| p.abs().max_element() > MAX_COORDINATE) {
-                return Err(bad_input!("{flag} {p}: coordinates must be within ±{MAX_COORDINATE:e}"));
-            }
-        }
         if let Some(target) = self.target {
             camera.target = target;
         }
@@ -167,18 +134,10 @@ impl SceneSettings {
         } else {
             self.lights.clone()
         };
-        for light in &lights {
-            if let Light::Point { position, .. } = light {
-                if position.abs().max_element() > MAX_COORDINATE {
-                    return Err(bad_input!("--light point:{position}: coordinates must be within ±{MAX_COORDINATE:e}"));
-                }
-            }
-        }
-        if lights.len() > crate::gpu::MAX_LIGHTS {
-            return Err(bad_input!("--light: at most {} lights, {} given", crate::gpu::MAX_LIGHTS, lights.len()));
-        }
+        // Checked as every frame's camera and lights are (`FrameDesc::validate`).
+        crate::frame_desc::check_camera(&camera)?;
+        crate::frame_desc::check_lights(&lights)?;
         let scene = Scene { mesh, camera, lights, mm_per_unit: self.scale };
-        scene.validate()?;
         Ok(rescaled(scene, radius))
     }
 }
@@ -204,134 +163,56 @@ fn rescaled(mut scene: Scene, radius: f32) -> Scene {
     scene
 }
 
-/// A frame's settings: the scene, how the subsurface term is integrated, and the image. Built
-/// from flags ([`RenderSettings::from_args`]) or in code ([`RenderSettings::new`] and fields);
-/// [`RenderSettings::frame_options`] makes the renderer's options from them.
+/// A frame's settings: the world (one object from the flags) and the frame's description, and
+/// whether to time the passes. Built from flags ([`RenderSettings::from_args`]) or in code
+/// ([`RenderSettings::new`] and fields).
 pub struct RenderSettings {
-    pub scene: Scene,
-    pub subsurface: SubsurfaceOptions,
-    pub width: u32,
-    pub height: u32,
-    /// Sample points (`None`: from the material's length scales and the mesh's area).
-    pub samples: Option<u32>,
-    /// Shadow-map resolution per light (per cube face for point lights).
-    pub shadow_resolution: u32,
-    pub show: Show,
-    pub exposure: Exposure,
+    pub world: World,
+    pub desc: FrameDesc,
     /// Time every pass with GPU timestamps.
     pub profile: bool,
-    /// Count the shading work per pixel on the GPU.
-    pub count_work: bool,
 }
 
 impl RenderSettings {
-    /// `scene` with `material` and the command line's defaults for everything else (directional
-    /// dipole, classical diffusion, the default ε, specular on, 512×512, timed, work not counted).
+    /// `scene` as a world of one object in `material`, with the command line's defaults for
+    /// everything else ([`FrameDesc::new`]), timed.
     pub fn new(scene: Scene, material: Material) -> RenderSettings {
+        let Scene { mesh, camera, lights, mm_per_unit } = scene;
         RenderSettings {
-            scene,
-            subsurface: SubsurfaceOptions {
-                material,
-                model: Model::Directional,
-                diffusion: Diffusion::Classical,
-                epsilon: DEFAULT_EPSILON,
-                brute_force: false,
-                specular: true,
-                roughness: DEFAULT_ROUGHNESS,
-            },
-            width: 512,
-            height: 512,
-            samples: None,
-            shadow_resolution: 1024,
-            show: Show::Shading,
-            exposure: Exposure::Auto,
+            world: World::single(mesh, material, mm_per_unit),
+            desc: FrameDesc::new(camera, lights),
             profile: true,
-            count_work: false,
         }
     }
 
     /// The settings of `render` and `view` from their flags, checked in the order the user reads
-    /// them: roughness, then the scene, then the material (which may print a warning).
+    /// them: roughness, then the scene, then the material (which may print a warning), then the
+    /// rest of the frame and the world.
     pub fn from_args(args: &RenderArgs) -> Result<RenderSettings> {
         check_roughness(args.roughness, "--roughness")?;
         let scene = SceneSettings::from_args(args).build()?;
         let material = args.material.material()?;
-        Ok(RenderSettings {
-            scene,
-            subsurface: SubsurfaceOptions {
-                material,
-                model: args.model.into(),
-                diffusion: args.diffusion.into(),
-                epsilon: args.epsilon,
-                brute_force: args.brute_force,
-                specular: !args.no_specular,
-                roughness: args.roughness,
-            },
-            width: args.width,
-            height: args.height,
-            samples: args.samples,
-            shadow_resolution: args.shadow_resolution,
-            show: match args.show {
-                ShowArg::Shading => Show::Shading,
-                ShowArg::Samples => Show::Samples,
-                ShowArg::Tree => Show::Tree(args.level),
-            },
-            exposure: args.exposure.map(Exposure::Stops).unwrap_or(Exposure::Auto),
-            profile: true,
-            count_work: args.profile,
-        })
+        let mut s = RenderSettings::new(scene, material);
+        s.world.objects[0].samples = args.samples;
+        let d = &mut s.desc;
+        d.integration = Integration {
+            model: args.model,
+            diffusion: args.diffusion.into(),
+            epsilon: args.epsilon,
+            brute_force: args.brute_force,
+        };
+        (d.width, d.height) = (args.width, args.height);
+        (d.specular, d.roughness) = (!args.no_specular, args.roughness);
+        d.shadow_resolution = args.shadow_resolution;
+        d.show = match args.show {
+            ShowArg::Shading => Show::Shading,
+            ShowArg::Samples => Show::Samples,
+            ShowArg::Tree => Show::Tree(args.level),
+        };
+        d.exposure = args.exposure.map(Exposure::Stops).unwrap_or(Exposure::Auto);
+        d.count_work = args.profile;
+        s.desc.validate()?;
+        s.world.validate()?;
+        Ok(s)
     }
-
-    /// The sample count: the one given (checked against the device), else the default for the
-    /// material and the mesh (printed).
-    pub fn point_count(&self, ctx: &Context) -> Result<u32> {
-        match self.samples {
-            Some(n) => {
-                crate::hierarchy::check_point_count(ctx, n, self.scene.lights.len() as u32)?;
-                Ok(n)
-            }
-            None => Ok(default_point_count(ctx, &self.scene, &self.subsurface.material)),
-        }
-    }
-
-    /// The renderer's options for `point_count` points; the hierarchy's η is the material's.
-    pub fn frame_options(&self, point_count: u32) -> FrameOptions {
-        let s = &self.subsurface;
-        FrameOptions {
-            subsurface: SubsurfaceOptions { material: s.material.clone(), ..*s },
-            width: self.width,
-            height: self.height,
-            profile: self.profile,
-            count_work: self.count_work,
-            hierarchy: HierarchyOptions {
-                point_count,
-                shadow_resolution: self.shadow_resolution,
-                eta: s.material.eta as f32,
-            },
-            show: self.show,
-            exposure: self.exposure,
-        }
-    }
-}
-
-/// Sample count from the material's shortest length scale (mean free path 1/σ't or diffusion
-/// length 1/σtr) and the mesh's area (in mm), within a budget; prints the choice and warns when
-/// points are farther apart than that length.
-pub fn default_point_count(ctx: &Context, scene: &Scene, material: &Material) -> u32 {
-    let mm = scene.mm_per_unit;
-    let area_mm2 = scene.mesh.surface_area() * mm * mm;
-    let shortest = (0..3)
-        .map(|ch| material.channel(ch).constants(Diffusion::Classical))
-        .filter(|c| c.transports && c.sigma_tr > 0.0)
-        .map(|c| (1.0 / c.sigma_tr).min(1.0 / c.sigma_t_reduced))
-        .fold(f64::INFINITY, f64::min) as f32;
-    let budget = crate::hierarchy::max_points(ctx, scene.lights.len() as u32).min(1 << 18);
-    let (n, spacing) = crate::hierarchy::choose_point_count(area_mm2, shortest, budget);
-    crate::note!(
-        "samples: {n} points, {spacing:.3} mm apart on {area_mm2:.0} mm² (shortest of mean free path and diffusion length: {shortest:.3} mm)"
-    );
-    if spacing > shortest {
-        crate::note!("warning: points are spaced wider than the mean free path or diffusion length; raise --samples for accuracy");
-    }
-    n
 }

@@ -250,18 +250,20 @@ fn render_flags_default_to_the_library_settings() {
     assert_eq!(SceneSettings::from_args(&args), scene);
     let flags = RenderSettings::from_args(&args).unwrap();
     let code = RenderSettings::new(scene.build().unwrap(), translucent::materials::Material::find("marble").unwrap());
-    let (a, b) = (&flags.subsurface, &code.subsurface);
-    assert_eq!((&a.material, a.model, a.diffusion), (&b.material, b.model, b.diffusion));
+    let (a, b) = (&flags.desc, &code.desc);
+    let material = |s: &RenderSettings| s.world.objects[0].material.clone();
+    let (ai, bi) = (a.integration, b.integration);
+    assert_eq!((material(&flags), ai.model, ai.diffusion), (material(&code), bi.model, bi.diffusion));
     assert_eq!(
-        (a.epsilon, a.brute_force, a.specular, a.roughness),
-        (b.epsilon, b.brute_force, b.specular, b.roughness)
+        (ai.epsilon, ai.brute_force, a.specular, a.roughness),
+        (bi.epsilon, bi.brute_force, b.specular, b.roughness)
     );
-    assert_eq!((flags.width, flags.height, flags.samples), (code.width, code.height, code.samples));
+    assert_eq!((flags.desc.width, flags.desc.height, flags.world.objects[0].samples), (code.desc.width, code.desc.height, code.world.objects[0].samples));
     assert_eq!(
-        (flags.shadow_resolution, flags.show, flags.exposure),
-        (code.shadow_resolution, code.show, code.exposure)
+        (flags.desc.shadow_resolution, flags.desc.show, flags.desc.exposure),
+        (code.desc.shadow_resolution, code.desc.show, code.desc.exposure)
     );
-    assert_eq!((flags.profile, flags.count_work), (code.profile, code.count_work));
+    assert_eq!((flags.profile, flags.desc.count_work), (code.profile, code.desc.count_work));
 }
 
 /// The binary renders exactly what the library renders from the same settings: the EXR of
@@ -283,8 +285,8 @@ fn render_writes_the_library_frame() {
         ..Default::default()
     };
     let mut s = RenderSettings::new(scene.build().unwrap(), translucent::materials::Material::find("marble").unwrap());
-    (s.width, s.height, s.samples) = (24, 20, Some(3000));
-    (s.subsurface.model, s.subsurface.epsilon) = (translucent::physics::Model::Dipole, 0.1);
+    (s.desc.width, s.desc.height, s.world.objects[0].samples) = (24, 20, Some(3000));
+    (s.desc.integration.model, s.desc.integration.epsilon) = (translucent::physics::Model::Dipole, 0.1);
     let library = common::render_hdr(&s);
     assert_eq!((cli.width(), cli.height()), (library.width, library.height));
     let differing =

@@ -6,34 +6,20 @@ mod common;
 use common::{assert_clean, output_dir, stderr, translucent, validated_context};
 use glam::Vec3;
 use translucent::deform::{Animation, Deformation};
-use translucent::frame::{FrameOptions, Renderer, Show, SubsurfaceOptions};
-use translucent::hierarchy::HierarchyOptions;
+use translucent::frame::Renderer;
+use translucent::frame_desc::{FrameDesc, Integration};
 use translucent::materials::Material;
 use translucent::mesh::Mesh;
 use translucent::output::{self, Exposure};
-use translucent::physics::{Diffusion, Model};
-use translucent::scene::{Camera, Light, Scene};
+use translucent::scene::{Camera, Light};
+use translucent::world::World;
 
-fn renderer_for(ctx: translucent::vk::Context, scene: &Scene, points: u32) -> Renderer {
-    let options = FrameOptions {
-        subsurface: SubsurfaceOptions {
-            material: Material::find("marble").unwrap(),
-            model: Model::Directional,
-            diffusion: Diffusion::Classical,
-            epsilon: 0.1,
-            brute_force: false,
-            specular: true,
-            roughness: 0.35,
-        },
-        width: 24,
-        height: 24,
-        profile: false,
-        count_work: false,
-        hierarchy: HierarchyOptions { point_count: points, shadow_resolution: 64, eta: 1.5 },
-        show: Show::Shading,
-        exposure: Exposure::Stops(0.0),
-    };
-    Renderer::new(ctx, scene, options).expect("renderer")
+/// Marble at 24x24 with `points` points, ε = 0.1, 64² shadow maps, exposure 0.
+fn frame_for(camera: Camera, lights: Vec<Light>) -> FrameDesc {
+    let mut desc = FrameDesc::new(camera, lights);
+    desc.integration = Integration { epsilon: 0.1, ..Integration::default() };
+    (desc.width, desc.height, desc.shadow_resolution, desc.exposure) = (24, 24, 64, Exposure::Stops(0.0));
+    desc
 }
 
 #[test]
@@ -42,23 +28,24 @@ fn each_frame_samples_the_deformed_surface() {
     let base = Mesh::slab(1.0, 1.0, 2.0);
     let camera = Camera::framing(Vec3::ZERO, 2.0, 40.0, Vec3::new(0.3, 0.3, 1.0));
     let lights = vec![Light::Directional { toward: Vec3::new(0.2, 1.0, 0.5), irradiance: Vec3::ONE }];
-    let mut scene = Scene { mesh: base.clone(), camera, lights, mm_per_unit: 10.0 };
+    let mut world = World::single(base.clone(), Material::find("marble").unwrap(), 10.0);
     let points = 2048;
-    let mut renderer = renderer_for(ctx, &scene, points);
+    world.objects[0].samples = Some(points);
+    let desc = frame_for(camera, lights);
+    let mut renderer = Renderer::new(ctx, false).expect("renderer");
     for deformation in [Deformation::Squash(0.25), Deformation::Twist(120.0)] {
         let animation = Animation::new("box", &base, Some(deformation), 4, Vec3::Y).unwrap().expect("animated");
         let mut areas = Vec::new();
         for frame in 0..4 {
-            scene.mesh = animation.mesh(frame).unwrap();
-            renderer.set_mesh(&scene.mesh).unwrap();
-            renderer.render_frame(&scene).unwrap();
-            let snapshot = renderer.hierarchy.download(&renderer.ctx).unwrap();
+            world.objects[0].mesh = animation.mesh(frame).unwrap();
+            renderer.render_frame(&world, &desc).unwrap();
+            let snapshot = renderer.hierarchy().unwrap().download(&renderer.ctx).unwrap();
             assert_eq!(snapshot.points.len(), points as usize);
             // The points' areas add up to the deformed mesh's area, and the points lie within it.
             let sampled: f64 = snapshot.points.iter().map(|p| p.area as f64).sum();
-            let area = scene.mesh.surface_area() as f64;
+            let area = world.objects[0].mesh.surface_area() as f64;
             assert!((sampled / area - 1.0).abs() < 1e-3, "{deformation:?} frame {frame}: {sampled} vs {area}");
-            let (lo, hi) = scene.mesh.bounds();
+            let (lo, hi) = world.objects[0].mesh.bounds();
             for p in &snapshot.points {
                 assert!(p.position.cmpge(lo - 1e-4).all() && p.position.cmple(hi + 1e-4).all(), "{p:?}");
             }

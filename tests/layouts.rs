@@ -19,26 +19,36 @@ fn shade_constants_match_glsl() {
 }
 
 #[test]
-fn subsurface_params_and_tree_match_glsl() {
-    use translucent::gpu::{SubsurfaceParams, SurfacePoint, TreeNode};
-    let params = member_offsets("shade.frag", "SubsurfaceParams").expect("SubsurfaceParams");
-    let rust: Vec<u32> = [
-        offset_of!(SubsurfaceParams, channels),
-        offset_of!(SubsurfaceParams, mm_per_unit),
-        offset_of!(SubsurfaceParams, epsilon),
-        offset_of!(SubsurfaceParams, model),
-        offset_of!(SubsurfaceParams, brute_force),
-        offset_of!(SubsurfaceParams, point_count),
-        offset_of!(SubsurfaceParams, node_count),
-        offset_of!(SubsurfaceParams, count_work),
-        offset_of!(SubsurfaceParams, specular),
-        offset_of!(SubsurfaceParams, roughness),
-    ]
-    .iter()
-    .map(|&o| o as u32)
-    .collect();
-    assert_eq!(params[..rust.len()], rust[..]);
-    assert_eq!(size_of::<SubsurfaceParams>(), 240);
+fn shading_params_and_tree_match_glsl() {
+    use translucent::gpu::{FrameParams, ObjectParams, SurfacePoint, TreeNode};
+    // The object's and the frame's parameters, in both shaders that read them.
+    for shader in ["shade.frag", "tile_cut.comp"] {
+        let object = member_offsets(shader, "ObjectParams").expect("ObjectParams");
+        let rust: Vec<u32> = [
+            offset_of!(ObjectParams, channels),
+            offset_of!(ObjectParams, mm_per_unit),
+            offset_of!(ObjectParams, point_count),
+            offset_of!(ObjectParams, node_count),
+        ]
+        .iter()
+        .map(|&o| o as u32)
+        .collect();
+        assert_eq!(object[..rust.len()], rust[..], "{shader}");
+        let frame = member_offsets(shader, "FrameParams").expect("FrameParams");
+        let rust: Vec<u32> = [
+            offset_of!(FrameParams, epsilon),
+            offset_of!(FrameParams, brute_force),
+            offset_of!(FrameParams, count_work),
+            offset_of!(FrameParams, specular),
+            offset_of!(FrameParams, roughness),
+        ]
+        .iter()
+        .map(|&o| o as u32)
+        .collect();
+        assert_eq!(frame[..rust.len()], rust[..], "{shader}");
+    }
+    assert_eq!(size_of::<ObjectParams>(), 208);
+    assert_eq!(size_of::<FrameParams>(), 32);
     let node = member_offsets("hierarchy/tree_aggregate.comp", "TreeNode").expect("TreeNode");
     let rust: Vec<u32> = [
         offset_of!(TreeNode, power),

@@ -13,7 +13,7 @@ use translucent::settings::{RenderSettings, SceneSettings, BUNNY};
 /// `scene` in marble at 96x96 with the command line's defaults otherwise.
 fn settings(scene: SceneSettings, exposure: Exposure) -> RenderSettings {
     let mut s = RenderSettings::new(scene.build().expect("scene"), Material::find("marble").unwrap());
-    (s.width, s.height, s.exposure) = (96, 96, exposure);
+    (s.desc.width, s.desc.height, s.desc.exposure) = (96, 96, exposure);
     s
 }
 
@@ -83,7 +83,7 @@ fn png_is_the_tone_mapped_exr() {
     for (name, exposure) in [("auto", None), ("fixed", Some(1.5))] {
         let stops = exposure.map(Exposure::Stops).unwrap_or(Exposure::Auto);
         let mut s = settings(scene("torus", None), stops);
-        (s.width, s.height) = (40, 24);
+        (s.desc.width, s.desc.height) = (40, 24);
         let (renderer, counts) = render_frame(&s);
         let (actual, hdr) = (renderer.tone_mapped_image().unwrap(), renderer.image().unwrap());
         drop(renderer);

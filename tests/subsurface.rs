@@ -16,8 +16,8 @@ use translucent::settings::{RenderSettings, SceneSettings, BUNNY};
 /// dipole: what the tree-against-brute-force tests start from.
 fn settings(scene: &SceneSettings) -> RenderSettings {
     let mut s = RenderSettings::new(scene.build().expect("scene"), Material::find("marble").unwrap());
-    (s.width, s.height, s.samples) = (64, 64, Some(4096));
-    s.subsurface.specular = false;
+    (s.desc.width, s.desc.height, s.world.objects[0].samples) = (64, 64, Some(4096));
+    s.desc.specular = false;
     s
 }
 
@@ -50,18 +50,18 @@ fn tree_matches_brute_force_within_one_percent() {
             let name = format!("{}-{model:?}", std::path::Path::new(&mesh).file_stem().unwrap().to_string_lossy());
             let scene = SceneSettings { mesh: Some(mesh.clone()), lights: vec![light], ..Default::default() };
             let mut s = settings(&scene);
-            s.subsurface.model = model;
-            s.subsurface.brute_force = true;
+            s.desc.integration.model = model;
+            s.desc.integration.brute_force = true;
             let reference = render(&s);
-            s.subsurface.brute_force = false;
-            let default_epsilon = s.subsurface.epsilon;
+            s.desc.integration.brute_force = false;
+            let default_epsilon = s.desc.integration.epsilon;
             let mut errors = Vec::new();
             for eps in [0.2, 0.1, 0.05, 0.01] {
-                s.subsurface.epsilon = eps;
+                s.desc.integration.epsilon = eps;
                 let tree = render(&s);
                 errors.push(relative_rmse(&tree, &reference));
             }
-            s.subsurface.epsilon = default_epsilon;
+            s.desc.integration.epsilon = default_epsilon;
             let default = render(&s);
             let error = relative_rmse(&default, &reference);
             println!("{name}: relative RMSE at epsilon 0.2, 0.1, 0.05, 0.01: {errors:.5?}; default {error:.5}");
@@ -82,11 +82,11 @@ fn tree_matches_brute_force_within_one_percent() {
 fn slab_centre(model: Model, light_dir: [f32; 3], extra: Integration) -> [f64; 3] {
     let scene = slab_scene(light_dir, 1.0);
     let mut s = slab_settings(&scene, model, 80_000);
-    (s.width, s.height) = (8, 8);
+    (s.desc.width, s.desc.height) = (8, 8);
     match extra {
-        Integration::BruteForce => s.subsurface.brute_force = true,
+        Integration::BruteForce => s.desc.integration.brute_force = true,
         Integration::Tree => {}
-        Integration::TreeWithSpecular(roughness) => (s.subsurface.specular, s.subsurface.roughness) = (true, roughness),
+        Integration::TreeWithSpecular(roughness) => (s.desc.specular, s.desc.roughness) = (true, roughness),
     }
     let img = render_hdr(&s);
     let p = img.pixels[(4 * img.width + 4) as usize];
@@ -123,9 +123,9 @@ fn slab_scene(light_dir: [f32; 3], fov: f32) -> SceneSettings {
 fn slab_settings(scene: &SceneSettings, model: Model, samples: u32) -> RenderSettings {
     let material = Material::custom([1.0, 0.5, 2.0], [2.0, 3.0, 1.0], [0.0; 3], 1.3).unwrap();
     let mut s = RenderSettings::new(scene.build().expect("slab scene"), material);
-    s.subsurface.model = model;
-    s.subsurface.specular = false;
-    s.samples = Some(samples);
+    s.desc.integration.model = model;
+    s.desc.specular = false;
+    s.world.objects[0].samples = Some(samples);
     s
 }
 
@@ -222,8 +222,8 @@ fn profile_counts_work_per_pixel() {
     let run = |brute_force: bool| {
         let scene = SceneSettings { mesh: Some("sphere".into()), ..Default::default() };
         let mut s = RenderSettings::new(scene.build().unwrap(), Material::find("marble").unwrap());
-        (s.width, s.height, s.samples, s.count_work) = (16, 16, Some(10000), true);
-        s.subsurface.brute_force = brute_force;
+        (s.desc.width, s.desc.height, s.world.objects[0].samples, s.desc.count_work) = (16, 16, Some(10000), true);
+        s.desc.integration.brute_force = brute_force;
         let (renderer, counts) = render_frame(&s);
         let work = renderer.work().unwrap();
         drop(renderer);
@@ -303,8 +303,8 @@ fn shadowed_slab(model: Model, travel: f32) -> f64 {
     };
     let material = Material::custom([0.05; 3], [2.0; 3], [0.0; 3], 1.3).unwrap();
     let mut s = RenderSettings::new(scene.build().expect("shadowed slab"), material);
-    (s.width, s.height, s.samples, s.shadow_resolution) = (8, 8, Some(200_000), 4096);
-    (s.subsurface.model, s.subsurface.brute_force, s.subsurface.specular) = (model, true, false);
+    (s.desc.width, s.desc.height, s.world.objects[0].samples, s.desc.shadow_resolution) = (8, 8, Some(200_000), 4096);
+    (s.desc.integration.model, s.desc.integration.brute_force, s.desc.specular) = (model, true, false);
     let img = render_hdr(&s);
     let p = img.pixels[(4 * img.width + 4) as usize];
     assert_eq!(p[3], 1.0);
@@ -393,7 +393,7 @@ fn back_lit_thin_slab_carries_light_forward() {
 fn slab_patch_mean(model: Model, light_dir: [f32; 3], samples: u32) -> [f64; 3] {
     let scene = slab_scene(light_dir, 10.0);
     let mut s = slab_settings(&scene, model, samples);
-    (s.width, s.height, s.subsurface.brute_force) = (8, 8, true);
+    (s.desc.width, s.desc.height, s.desc.integration.brute_force) = (8, 8, true);
     let img = render_hdr(&s);
     let mut sum = [0.0f64; 3];
     for p in &img.pixels {
@@ -466,7 +466,7 @@ fn lights_add_exactly_under_both_models() {
             let method = if brute_force { "brute force" } else { "tree" };
             let render_with = |lights: &[Light]| {
                 let mut s = settings(&lit(&fixed, lights));
-                (s.subsurface.model, s.subsurface.brute_force) = (model, brute_force);
+                (s.desc.integration.model, s.desc.integration.brute_force) = (model, brute_force);
                 render(&s)
             };
             let both = render_with(&[a, b]);
@@ -532,9 +532,9 @@ fn tree_has_no_bias_against_brute_force() {
     for (name, scene, material) in [("skin1-sphere", &skin, &skin1), ("slab", &slab, &slab_material)] {
         for model in [Model::Directional, Model::Dipole] {
             let mut s = settings(scene);
-            (s.subsurface.material, s.subsurface.model, s.subsurface.brute_force) = (material.clone(), model, true);
+            (s.world.objects[0].material, s.desc.integration.model, s.desc.integration.brute_force) = (material.clone(), model, true);
             let brute = render(&s);
-            s.subsurface.brute_force = false;
+            s.desc.integration.brute_force = false;
             let tree = render(&s);
             let bias = mean_bias(&tree, &brute);
             println!("{name} {model:?}: tree − brute force, mean per channel {bias:+.5?}");

@@ -5,38 +5,25 @@
 mod common;
 
 use glam::Vec3;
-use translucent::frame::{FrameOptions, Renderer, Show, SubsurfaceOptions};
-use translucent::hierarchy::HierarchyOptions;
+use translucent::frame::Renderer;
+use translucent::frame_desc::{FrameDesc, Integration};
 use translucent::mesh::Mesh;
-use translucent::output::Exposure;
-use translucent::scene::{bounding_sphere, Camera, Light, Scene};
+use translucent::scene::{bounding_sphere, Camera, Light};
+use translucent::world::World;
 
-fn torus_renderer(brute_force: bool) -> (Renderer, Scene, std::sync::Arc<translucent::vk::ValidationCounts>) {
+/// A skin torus at 70x45 with 9000 points and ε = 0.1: the renderer, the world and the frame.
+fn torus_renderer(brute_force: bool) -> (Renderer, (World, FrameDesc), std::sync::Arc<translucent::vk::ValidationCounts>) {
     let (ctx, counts) = common::validated_context();
     let mesh = Mesh::from_spec("torus").unwrap();
     let (centre, radius) = bounding_sphere(&mesh.positions);
     let camera = Camera::framing(centre, radius, 40.0, Vec3::new(0.3, 0.6, 1.0));
     let lights = vec![Light::Directional { toward: Vec3::new(-0.3, 0.7, -0.65), irradiance: Vec3::ONE }];
-    let scene = Scene { mesh, camera, lights, mm_per_unit: 10.0 };
-    let options = FrameOptions {
-        subsurface: SubsurfaceOptions {
-            material: translucent::materials::Material::find("skin1").unwrap(),
-            model: translucent::physics::Model::Directional,
-            diffusion: translucent::physics::Diffusion::Classical,
-            epsilon: 0.1,
-            brute_force,
-            specular: true,
-            roughness: 0.35,
-        },
-        width: 70,
-        height: 45,
-        profile: false,
-        count_work: false,
-        hierarchy: HierarchyOptions { point_count: 9000, shadow_resolution: 512, eta: 1.3 },
-        show: Show::Shading,
-        exposure: Exposure::Auto,
-    };
-    (Renderer::new(ctx, &scene, options).unwrap(), scene, counts)
+    let mut world = World::single(mesh, translucent::materials::Material::find("skin1").unwrap(), 10.0);
+    world.objects[0].samples = Some(9000);
+    let mut desc = FrameDesc::new(camera, lights);
+    desc.integration = Integration { epsilon: 0.1, brute_force, ..Integration::default() };
+    (desc.width, desc.height, desc.shadow_resolution) = (70, 45, 512);
+    (Renderer::new(ctx, false).unwrap(), (world, desc), counts)
 }
 
 fn render(brute_force: bool, tiles: &[u32]) -> Vec<Vec<[f32; 4]>> {
@@ -45,7 +32,7 @@ fn render(brute_force: bool, tiles: &[u32]) -> Vec<Vec<[f32; 4]>> {
         .iter()
         .map(|&tile| {
             renderer.set_tile_size(tile);
-            renderer.render_frame(&scene).unwrap();
+            renderer.render_frame(&scene.0, &scene.1).unwrap();
             renderer.image().unwrap().pixels
         })
         .collect();
@@ -84,22 +71,22 @@ fn relative_rmse(a: &[[f32; 4]], reference: &[[f32; 4]]) -> f64 {
 #[test]
 fn tile_lists_grow_or_fall_back_to_walks_from_the_root() {
     let (mut renderer, scene, counts) = torus_renderer(false);
-    renderer.render_frame(&scene).unwrap();
+    renderer.render_frame(&scene.0, &scene.1).unwrap();
     let full = renderer.image().unwrap().pixels;
     let (needed, capacity) = renderer.tile_list_entries().unwrap();
     assert!(needed > 1000 && needed <= capacity, "the default lists hold the frame's: {needed} of {capacity}");
 
     renderer.set_tile_lists(64, None).unwrap();
-    renderer.render_frame(&scene).unwrap();
+    renderer.render_frame(&scene.0, &scene.1).unwrap();
     let (_, grown) = renderer.tile_list_entries().unwrap();
     assert!(grown >= needed, "grown to {grown} for {needed}");
     assert!(renderer.image().unwrap().pixels == full, "grown lists shade as the default ones");
 
     renderer.set_tile_lists(needed / 2, Some(needed / 2)).unwrap();
-    renderer.render_frame(&scene).unwrap();
+    renderer.render_frame(&scene.0, &scene.1).unwrap();
     let half = renderer.image().unwrap().pixels;
     renderer.set_tile_lists(4, Some(4)).unwrap();
-    renderer.render_frame(&scene).unwrap();
+    renderer.render_frame(&scene.0, &scene.1).unwrap();
     let from_root = renderer.image().unwrap().pixels;
     drop(renderer);
     common::assert_clean(&counts);

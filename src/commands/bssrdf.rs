@@ -6,7 +6,6 @@ use crate::physics::{Diffusion, Model};
 use crate::vk::Context;
 use crate::{bad_input, runtime};
 
-use super::validation_exit_code;
 
 pub(super) fn bssrdf(args: &BssrdfArgs) -> Result<i32> {
     use std::io::Write;
@@ -68,7 +67,7 @@ pub(super) fn bssrdf(args: &BssrdfArgs) -> Result<i32> {
             let (counts, validating) = (ctx.validation_counts(), ctx.validation);
             drop(pass);
             drop(ctx);
-            validation_exit_code(validating, &counts)
+            counts.exit_code(validating)
         }
         None => 0,
     })

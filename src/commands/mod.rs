@@ -13,7 +13,6 @@ use crate::bad_input;
 use crate::cli::{BenchArgs, Cli, Command};
 use crate::error::Result;
 use crate::settings::BUNNY;
-use crate::vk;
 
 /// Runs a parsed command; `Ok(code)` is the exit code when it finished without an error.
 pub fn run(cli: Cli) -> Result<i32> {
@@ -53,20 +52,6 @@ fn bench(args: &BenchArgs) -> Result<i32> {
     };
     crate::error::write_stdout(&crate::bench::run(&options)?)?;
     Ok(0)
-}
-
-/// Exit code 1 (with a summary on stderr) when the validation layer reported anything.
-pub fn validation_exit_code(validating: bool, counts: &vk::ValidationCounts) -> i32 {
-    use std::sync::atomic::Ordering;
-    let (w, e) = (counts.warnings.load(Ordering::SeqCst), counts.errors.load(Ordering::SeqCst));
-    if w + e > 0 {
-        crate::note!("error: validation reported {e} error(s) and {w} warning(s)");
-        return 1;
-    }
-    if validating {
-        log::info!("validation: no messages");
-    }
-    0
 }
 
 fn check_output_path(path: &Path, flag: &str, allowed: &[&str]) -> Result<()> {

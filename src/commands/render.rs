@@ -3,11 +3,12 @@
 use crate::cli::RenderArgs;
 use crate::error::Result;
 use crate::frame::Renderer;
+use crate::profiling::ProfileReport;
+use crate::runtime;
 use crate::settings::{RenderSettings, SceneSettings};
-use crate::vk::{self, Context};
-use crate::{bad_input, runtime};
+use crate::vk::Context;
 
-use super::{check_output_path, frame_path, validation_exit_code};
+use super::{check_output_path, frame_path};
 
 pub(super) fn render(args: &RenderArgs) -> Result<i32> {
     // Check everything the user typed before the (slow) device start.
@@ -15,36 +16,12 @@ pub(super) fn render(args: &RenderArgs) -> Result<i32> {
     if let Some(p) = &args.profile_out {
         check_output_path(p, "--profile-out", &["json"])?;
     }
-    let settings = RenderSettings::from_args(args)?;
-    let material = &settings.subsurface.material;
-    // The GPU shades in f32 (see `bssrdf --gpu`).
-    if let Some(ch) = (0..3).find(|&c| material.sigma_a[c] + material.sigma_s[c] > crate::bssrdf_csv::GPU_MAX_SIGMA_T) {
-        return Err(bad_input!(
-            "--sigma-a/--sigma-s: σa + σs = {:e} /mm in channel {ch} is above {:e}, beyond what rendering in f32 can hold",
-            material.sigma_a[ch] + material.sigma_s[ch],
-            crate::bssrdf_csv::GPU_MAX_SIGMA_T
-        ));
-    }
+    let RenderSettings { mut world, mut desc, profile } = RenderSettings::from_args(args)?;
     let ctx = Context::new(&args.device.options())?;
     let counts = ctx.validation_counts();
     let validating = ctx.validation;
     let device_name = format!("{} ({})", ctx.info.name, ctx.info.driver);
-
-    let point_count = settings.point_count(&ctx)?;
-    crate::budget::check_frame(
-        &ctx,
-        &crate::budget::FrameSizes {
-            width: args.width,
-            height: args.height,
-            shadow_resolution: args.shadow_resolution,
-            shadow_layers: crate::budget::FrameSizes::shadow_layers(&settings.scene.lights),
-            point_count,
-            light_count: settings.scene.lights.len() as u32,
-        },
-    )?;
-    let options = settings.frame_options(point_count);
-    let mut scene = settings.scene;
-    let mut renderer = Renderer::new(ctx, &scene, options)?;
+    let mut renderer = Renderer::new(ctx, profile)?;
     // A progress bar over the shading of every frame; indicatif hides it off a terminal.
     let bar = indicatif::ProgressBar::new(Renderer::progress_length(args.frames));
     bar.set_style(
@@ -57,18 +34,18 @@ pub(super) fn render(args: &RenderArgs) -> Result<i32> {
 
     let every_frame = args.out.to_string_lossy().contains("{frame}");
     let mesh_spec = SceneSettings::from_args(args).mesh_spec();
-    let animation = crate::deform::Animation::new(&mesh_spec, &scene.mesh, args.deform, args.deform_period, args.up)?;
-    let base_lights = scene.lights.clone();
-    let (centre, _) = crate::scene::bounding_sphere(&scene.mesh.positions);
+    let first_mesh = world.objects[0].mesh.clone();
+    let animation = crate::deform::Animation::new(&mesh_spec, &first_mesh, args.deform, args.deform_period, args.up)?;
+    let base_lights = desc.lights.clone();
+    let (centre, _) = crate::scene::bounding_sphere(&first_mesh.positions);
     let mut frames = Vec::new();
     for index in 0..args.frames {
         let angle = (args.spin_light * index as f32).to_radians();
-        scene.lights = base_lights.iter().map(|l| l.rotated(args.up, angle, centre)).collect();
+        desc.lights = base_lights.iter().map(|l| l.rotated(args.up, angle, centre)).collect();
         if let Some(animation) = animation.as_ref().filter(|_| index > 0) {
-            scene.mesh = animation.mesh(index)?;
-            renderer.set_mesh(&scene.mesh)?;
+            world.objects[0].mesh = animation.mesh(index)?;
         }
-        frames.push(renderer.render_frame(&scene)?);
+        frames.push(renderer.render_frame(&world, &desc)?);
         if every_frame {
             let path = frame_path(&args.out, index);
             renderer.write_image(&path)?;
@@ -88,7 +65,12 @@ pub(super) fn render(args: &RenderArgs) -> Result<i32> {
     drop(renderer);
 
     if frames.iter().any(|f| !f.is_empty()) {
-        report_profile(&device_name, frames, args)?;
+        let report = ProfileReport::from_frames(&device_name, frames);
+        crate::error::write_stdout(&crate::profiling::format_table(&report))?;
+        if let Some(path) = &args.profile_out {
+            crate::output::write_file(path, crate::profiling::chrome_trace_json(&report).as_bytes())
+                .map_err(|e| runtime!("--profile-out: {e}"))?;
+        }
     }
     if args.profile && work.pixels > 0 {
         let per_pixel = |sum: u32| sum as f64 / work.pixels as f64;
@@ -102,22 +84,5 @@ pub(super) fn render(args: &RenderArgs) -> Result<i32> {
             per_pixel(work.evaluation_sum)
         ))?;
     }
-    Ok(validation_exit_code(validating, &counts))
-}
-
-fn report_profile(device: &str, frames: Vec<Vec<vk::TimedScope>>, args: &RenderArgs) -> Result<()> {
-    use crate::profiling::{ProfileReport, Scope};
-    let report = ProfileReport {
-        device: device.to_string(),
-        frames: frames
-            .into_iter()
-            .map(|f| f.into_iter().map(|s| Scope { name: s.name, begin_ns: s.begin_ns, end_ns: s.end_ns }).collect())
-            .collect(),
-    };
-    crate::error::write_stdout(&crate::profiling::format_table(&report))?;
-    if let Some(path) = &args.profile_out {
-        crate::output::write_file(path, crate::profiling::chrome_trace_json(&report).as_bytes())
-            .map_err(|e| runtime!("--profile-out: {e}"))?;
-    }
-    Ok(())
+    Ok(counts.exit_code(validating))
 }

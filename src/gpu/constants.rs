@@ -3,7 +3,8 @@
 // (`const uint NAME = VALUEu;`), which the shaders include; so this file must stand alone (no
 // `crate::` paths, no `use`).
 
-/// `SubsurfaceParams.model` and the BSSRDF evaluation's push constant: the directional dipole.
+/// The shade pipeline's specialisation constant and the BSSRDF evaluation's push constant: the
+/// directional dipole (registered in src/models.rs).
 pub const MODEL_DIRECTIONAL: u32 = 0;
 /// The same for the classical dipole.
 pub const MODEL_DIPOLE: u32 = 1;
@@ -29,7 +30,7 @@ pub const MAX_CUT_STEPS: u32 = 24000;
 /// Evaluations in one tile's list (the shade pass loops once per evaluation), past which the cut
 /// pass uses nodes whole.
 pub const MAX_LIST_EVALUATIONS: u32 = 16384;
-/// Entries of the classical dipole's Sd table (`physics::dipole::SdTable`, bssrdf.glsl).
+/// Entries of the classical dipole's Sd table (`gpu::SdTable`, bssrdf.glsl).
 pub const DIPOLE_TABLE_SIZE: u32 = 4096;
 
 /// Every constant of the GLSL header, by its GLSL name.

@@ -4,7 +4,9 @@
 //!
 //! - `points`: points.glsl (surface points, their light records, tree nodes);
 //! - `lights`: lights.glsl;
-//! - `subsurface`: subsurface_params.glsl and bssrdf.glsl's per-channel constants;
+//! - `subsurface`: shading_params.glsl (per object, per frame) and bssrdf.glsl's per-channel
+//!   constants;
+//! - `dipole_table`: the classical dipole's Sd table as bssrdf.glsl reads it (f16 pairs);
 //! - `shade`: shade_constants.glsl and shade.frag's work counters;
 //! - `passes`: the other passes' push constants and blocks (bssrdf_eval.comp, tonemap.comp, the
 //!   hierarchy's compute shaders, the debug views);
@@ -12,6 +14,7 @@
 //!   `gpu_constants.glsl`.
 
 pub mod constants;
+pub mod dipole_table;
 pub mod lights;
 pub mod passes;
 pub mod points;
@@ -19,6 +22,7 @@ pub mod shade;
 pub mod subsurface;
 
 pub use constants::*;
+pub use dipole_table::SdTable;
 pub use lights::*;
 pub use passes::*;
 pub use points::*;

@@ -1,4 +1,4 @@
-//! subsurface_params.glsl, and the per-channel constants of bssrdf.glsl it holds.
+//! shading_params.glsl, and the per-channel constants of bssrdf.glsl it holds.
 
 use bytemuck::{Pod, Zeroable};
 
@@ -54,17 +54,25 @@ impl From<&ChannelConstants> for GpuChannel {
     }
 }
 
-/// Mirrors `SubsurfaceParams` in shaders/include/subsurface_params.glsl.
+/// One object's shading parameters: its material's constants and its tree's size. Mirrors
+/// `ObjectParams` in shaders/include/shading_params.glsl.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct SubsurfaceParams {
+pub struct ObjectParams {
     pub channels: [GpuChannel; 3],
     pub mm_per_unit: f32,
-    pub epsilon: f32,
-    pub model: u32,
-    pub brute_force: u32,
     pub point_count: u32,
     pub node_count: u32,
+    pub pad: u32,
+}
+
+/// How a frame integrates, written from the frame's description when it begins. Mirrors
+/// `FrameParams` in shaders/include/shading_params.glsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct FrameParams {
+    pub epsilon: f32,
+    pub brute_force: u32,
     /// 1 to count the work per pixel (nodes visited, points evaluated) for `--profile`.
     pub count_work: u32,
     /// 1 to add the microfacet lobe.

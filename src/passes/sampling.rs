@@ -5,6 +5,12 @@ use crate::error::Result;
 use crate::gpu::SampleConstants;
 use crate::vk::{Bind, Buffer, Context, Pipeline, Recorder};
 
+/// Bytes of the triangle-area prefix sum for `triangles` triangles: the total area (f32 and
+/// padding), then T + 1 64-bit fixed-point sums (shaders/hierarchy/triangle_areas.comp).
+pub fn prefix_bytes(triangles: u32) -> u64 {
+    8 + (triangles as u64 + 1) * 8
+}
+
 pub struct SamplingPass {
     areas: Pipeline,
     points: Pipeline,
@@ -30,6 +36,20 @@ impl SamplingPass {
         point_count: u32,
         seed: u32,
     ) -> Result<()> {
+        // The bytes the shaders will touch for these counts, against the buffers bound: the
+        // validation layer's GPU-assisted mode, which would catch a write past the end, does not
+        // run on lavapipe (see README "Validation").
+        let n = point_count as u64;
+        let t = triangle_count as u64;
+        for (buffer, needed) in [(indices, t * 12), (prefix, prefix_bytes(triangle_count)), (points, n * 64)] {
+            if buffer.size < needed {
+                return Err(crate::runtime!(
+                    "sampling: {} holds {} bytes; {triangle_count} triangles and {point_count} points need {needed}",
+                    buffer.name,
+                    buffer.size
+                ));
+            }
+        }
         rec.dispatch(
             &self.areas,
             &[Bind::Read(vertices), Bind::Read(indices), Bind::Write(prefix)],

@@ -2,12 +2,16 @@
 //! (depth, world position, normal: shaders/surface.frag); the shade pass is a full-screen
 //! triangle per tile that, per pixel, integrates the BSSRDF over the tree (shaders/shade.frag),
 //! plus the surface's microfacet reflection. Surface reads: vertices, indices; writes: depth,
-//! position, normal, and clears colour and work counters. Shade reads: parameters, tree nodes,
+//! position, normal, and clears colour and work counters. Shade reads: the object's and the
+//! frame's parameters, tree nodes,
 //! sorted points, their light records, lights, shadow maps, position and normal; writes: colour,
 //! work counters.
 
+use std::collections::HashMap;
+
 use crate::error::Result;
 use crate::gpu::ShadeConstants;
+use crate::physics::Model;
 use crate::vk::{
     self, Bind, Buffer, Context, CullModeFlags, Format, GraphicsDesc, Image, Pipeline, PrimitiveTopology, Recorder,
     Sampler,
@@ -32,7 +36,9 @@ pub struct ShadeInputs<'a> {
     pub vertices: &'a Buffer,
     pub indices: &'a Buffer,
     pub index_count: u32,
-    pub params: &'a Buffer,
+    /// The object's parameters (`ObjectParams`) and the frame's (`FrameParams`).
+    pub object_params: &'a Buffer,
+    pub frame_params: &'a Buffer,
     pub nodes: &'a Buffer,
     pub points: &'a Buffer,
     pub work: &'a Buffer,
@@ -81,15 +87,15 @@ pub fn shade_units(width: u32, height: u32, tile: u32, brute_force_points: Optio
 pub struct ShadePass {
     /// The mesh to the G-buffer (depth, position, normal).
     surface: Pipeline,
-    /// Shading per model (`Model::gpu_code`), made on first use: [model][additive], the additive
-    /// one for brute force in several draws.
-    shading: [[Option<Pipeline>; 2]; 2],
+    /// Shading per model and blending (additive for brute force in several draws), made on
+    /// first use.
+    shading: HashMap<(Model, bool), Pipeline>,
 }
 
 /// Bytes per vertex: position and normal, 3 floats each.
 const VERTEX_STRIDE: u32 = 24;
 
-fn shading_pipeline(ctx: &Context, model: u32, additive_blend: bool) -> Result<Pipeline> {
+fn shading_pipeline(ctx: &Context, model: Model, additive_blend: bool) -> Result<Pipeline> {
     Pipeline::graphics(
         ctx,
         &GraphicsDesc {
@@ -104,7 +110,7 @@ fn shading_pipeline(ctx: &Context, model: u32, additive_blend: bool) -> Result<P
             depth_bias: false,
             cull_mode: CullModeFlags::NONE,
             additive_blend,
-            specialization: &[model],
+            specialization: &[model.gpu_code()],
         },
     )
 }
@@ -128,18 +134,16 @@ impl ShadePass {
                 specialization: &[],
             },
         )?;
-        Ok(ShadePass { surface, shading: Default::default() })
+        Ok(ShadePass { surface, shading: HashMap::new() })
     }
 
     /// Makes the shading pipeline of `model` (and its additive twin for brute force) if not made
     /// yet: each is a compilation on llvmpipe, so only what a frame uses is made.
-    pub fn prepare(&mut self, ctx: &Context, model: u32, brute_force: bool) -> Result<()> {
-        let slots = &mut self.shading[model as usize];
-        if slots[0].is_none() {
-            slots[0] = Some(shading_pipeline(ctx, model, false)?);
-        }
-        if brute_force && slots[1].is_none() {
-            slots[1] = Some(shading_pipeline(ctx, model, true)?);
+    pub fn prepare(&mut self, ctx: &Context, model: Model, brute_force: bool) -> Result<()> {
+        for additive in [false, true].into_iter().take(1 + brute_force as usize) {
+            if !self.shading.contains_key(&(model, additive)) {
+                self.shading.insert((model, additive), shading_pipeline(ctx, model, additive)?);
+            }
         }
         Ok(())
     }
@@ -166,10 +170,10 @@ impl ShadePass {
         inputs: &ShadeInputs,
         constants: &ShadeConstants,
         unit: &ShadeUnit,
-        model: u32,
+        model: Model,
     ) -> Result<()> {
         let binds = [
-            Bind::Uniform(inputs.params),
+            Bind::Uniform(inputs.object_params),
             Bind::Texels(inputs.nodes),
             Bind::Texels(inputs.points),
             Bind::Write(inputs.work),
@@ -182,13 +186,14 @@ impl ShadePass {
             Bind::Texels(inputs.tile_headers),
             Bind::Texels(inputs.tile_entries),
             Bind::Texels(inputs.dipole_table),
+            Bind::Uniform(inputs.frame_params),
         ];
         let mut c = *constants;
         c.point_range = glam::UVec4::new(unit.first_point, unit.point_count, 0, 0);
         let additive = unit.point_count > 0;
-        let pipeline = self.shading[model as usize][additive as usize]
-            .as_ref()
-            .ok_or_else(|| crate::runtime!("shade: the pipeline for model {model} was not prepared"))?;
+        let pipeline = self.shading.get(&(model, additive)).ok_or_else(|| {
+            crate::runtime!("shade: the pipeline of the {} model was not prepared", model.name())
+        })?;
         // One rendering scope per unit: every draw writes the work counters, and the barrier
         // between two writes cannot sit inside a rendering scope.
         rec.prepare_draw_reads(&binds)?;

@@ -1,6 +1,6 @@
 //! The tile-cut pass (shaders/tile_cut.comp): per screen tile of `TILE_SIZE`² pixels, the list of
 //! tree nodes and points that are far and small enough for every pixel of the tile, so that the
-//! shade pass's lanes for a tile evaluate the same sources in step. Reads: subsurface parameters,
+//! shade pass's lanes for a tile evaluate the same sources in step. Reads: the object's and the frame's parameters,
 //! tree nodes, sorted points, the G-buffer's positions. Writes: tile headers, list entries, the
 //! allocation counter.
 
@@ -98,7 +98,7 @@ impl TileCutPass {
     pub fn record(
         &self,
         rec: &mut Recorder,
-        params: &Buffer,
+        (object_params, frame_params): (&Buffer, &Buffer),
         nodes: &Buffer,
         points: &Buffer,
         position: &Image,
@@ -115,13 +115,14 @@ impl TileCutPass {
         rec.dispatch(
             &self.pipeline,
             &[
-                Bind::Uniform(params),
+                Bind::Uniform(object_params),
                 Bind::Texels(nodes),
                 Bind::Texels(points),
                 Bind::StorageImageRead(position),
                 Bind::Write(&lists.headers),
                 Bind::Write(&lists.entries),
                 Bind::Write(&lists.allocation),
+                Bind::Uniform(frame_params),
             ],
             bytemuck::bytes_of(&constants),
             [lists.tiles[0].div_ceil(8), lists.tiles[1], 1],

@@ -1,5 +1,6 @@
 //! The BSSRDF physics in f64, the reference for tests and tools. `shaders/include/bssrdf.glsl`
-//! mirrors it in f32 for the GPU; [`crate::gpu::GpuChannel`] carries the constants computed here to it.
+//! mirrors it in f32 for the GPU, and `crate::gpu` carries the constants computed here to it; this
+//! module imports nothing of the GPU (src/models.rs registers each model's GPU code).
 //!
 //! Conventions (see `shared/reference/bssrdf.md`): per colour channel, coefficients in mm⁻¹,
 //! lengths in mm, normals outward, ωi from the surface toward the light, η = n_inside/n_outside.
@@ -19,24 +20,14 @@ pub enum Diffusion {
     Alternative,
 }
 
-/// Which BSSRDF.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+/// Which BSSRDF (each registered in src/models.rs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
 pub enum Model {
     /// Frisvad, Hachisuka, Kjeldsen 2014.
     #[default]
     Directional,
     /// Jensen, Marschner, Levoy, Hanrahan 2001.
     Dipole,
-}
-
-impl Model {
-    /// How the GPU names the model (`SubsurfaceParams.model`, the BSSRDF evaluation's push constant).
-    pub const fn gpu_code(self) -> u32 {
-        match self {
-            Model::Directional => crate::gpu::MODEL_DIRECTIONAL,
-            Model::Dipole => crate::gpu::MODEL_DIPOLE,
-        }
-    }
 }
 
 /// One colour channel of a medium.

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use glam::{Quat, Vec3};
 
 use crate::bad_input;
+use crate::cli::{finite_f32 as number, triple};
 use crate::error::Result;
 use crate::physics::Model;
 use crate::scene::{Camera, Light};
@@ -77,7 +78,7 @@ pub enum Setting {
     /// Sample points (a new hierarchy).
     Samples(u32),
     /// The debug view drawn over the shading.
-    Show(crate::frame::Show),
+    Show(crate::frame_desc::Show),
 }
 
 /// A parsed script line, with its 1-based number for messages.
@@ -110,14 +111,6 @@ pub fn parse_script(text: &str) -> std::result::Result<Vec<ScriptLine>, (usize, 
     Ok(lines)
 }
 
-fn number(s: &str) -> std::result::Result<f32, String> {
-    let v: f32 = s.parse().map_err(|_| format!("'{s}' is not a number"))?;
-    if !v.is_finite() {
-        return Err(format!("'{s}' is not finite"));
-    }
-    Ok(v)
-}
-
 fn count(s: &str) -> std::result::Result<u32, String> {
     s.parse().map_err(|_| format!("'{s}' is not a whole number ≥ 0"))
 }
@@ -127,18 +120,6 @@ fn on_off(s: &str) -> std::result::Result<bool, String> {
         "on" | "true" | "1" => Ok(true),
         "off" | "false" | "0" => Ok(false),
         _ => Err(format!("'{s}' is neither on nor off")),
-    }
-}
-
-fn triple(s: &str) -> std::result::Result<[f64; 3], String> {
-    let v: Vec<f64> = s
-        .split(',')
-        .map(|x| x.trim().parse::<f64>().map_err(|_| format!("'{x}' is not a number")))
-        .collect::<std::result::Result<_, _>>()?;
-    match v.as_slice() {
-        [x] => Ok([*x; 3]),
-        [r, g, b] => Ok([*r, *g, *b]),
-        _ => Err(format!("'{s}' is neither one number nor R,G,B")),
     }
 }
 
@@ -209,14 +190,12 @@ pub fn parse_line(line: &str) -> std::result::Result<Action, String> {
                 "specular" => Setting::Specular(on_off(value)?),
                 "roughness" => {
                     let r = number(value)?;
-                    crate::settings::check_roughness(r, "roughness").map_err(|e| e.to_string())?;
+                    crate::frame_desc::check_roughness(r, "roughness").map_err(|e| e.to_string())?;
                     Setting::Roughness(r)
                 }
-                "model" => Setting::Model(match value {
-                    "directional" => Model::Directional,
-                    "dipole" | "classical" => Model::Dipole,
-                    _ => return Err(format!("model '{value}': directional or dipole")),
-                }),
+                "model" => Setting::Model(
+                    Model::from_name(value).ok_or_else(|| format!("model '{value}': {}", Model::names()))?,
+                ),
                 "brute-force" => Setting::BruteForce(on_off(value)?),
                 "sigma-a" => Setting::SigmaA(triple(value)?),
                 "sigma-s" => Setting::SigmaS(triple(value)?),
@@ -230,9 +209,9 @@ pub fn parse_line(line: &str) -> std::result::Result<Action, String> {
                     Setting::Samples(n)
                 }
                 "show" => Setting::Show(match value.split_once(':') {
-                    None if value == "shading" => crate::frame::Show::Shading,
-                    None if value == "samples" => crate::frame::Show::Samples,
-                    Some(("tree", level)) => crate::frame::Show::Tree(count(level)?),
+                    None if value == "shading" => crate::frame_desc::Show::Shading,
+                    None if value == "samples" => crate::frame_desc::Show::Samples,
+                    Some(("tree", level)) => crate::frame_desc::Show::Tree(count(level)?),
                     _ => return Err(format!("show '{value}': shading, samples or tree:LEVEL")),
                 }),
                 other => {

@@ -1,19 +1,23 @@
 //! `translucent view`: the renderer's frames in a window, with an orbit camera, light and material
 //! edits from the mouse, the keys or a `--script`, scripted frame counts and screenshots.
 //!
-//! The frame is the same `Renderer::render_frame` as `render` and the tests; its tone-mapped image
-//! is copied into an image that the presenter blits to the window (src/vk/swapchain.rs).
+//! In three parts: this file, the window and its input turned into actions (and carrying out the
+//! schedule's plan); `schedule.rs`, when to render what (pure, unit-tested); `state.rs`, the world
+//! and frame description that actions edit, by one route. The frame is the same
+//! `Renderer::begin_frame` / `shade_some` / `finish_frame` as `render` and the tests; its
+//! tone-mapped image is copied into an image that the presenter blits to the window
+//! (src/vk/swapchain.rs).
 
 pub mod controls;
 mod panel;
+pub mod schedule;
+pub mod state;
 
 use std::collections::VecDeque;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use clap::Args;
-use glam::Vec3;
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalSize;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
@@ -22,55 +26,17 @@ use winit::keyboard::{Key, ModifiersState, NamedKey};
 use winit::raw_window_handle::{HasDisplayHandle, HasWindowHandle};
 use winit::window::{Window, WindowId};
 
-use crate::cli::RenderArgs;
-use crate::commands::validation_exit_code;
+use crate::cli::ViewArgs;
 use crate::error::{Error, Result};
-use crate::frame::{FrameInProgress, Renderer, Show, SubsurfaceOptions};
-use crate::output::Exposure;
-use crate::scene::Scene;
+use crate::frame::{FrameInProgress, Renderer};
+use crate::frame_desc::Show;
+use crate::profiling::ProfileReport;
 use crate::settings::{RenderSettings, SceneSettings};
-use crate::vk::{self, Context, Image, ImageUsageFlags, PresentMode, Presented, Presenter, TimedScope};
+use crate::vk::{self, Context, Image, ImageUsageFlags, Presented, Presenter, TimedScope};
 use crate::{bad_input, runtime};
 use controls::{Action, Drag, ScriptLine, Setting};
-
-#[derive(Args, Debug)]
-pub struct ViewArgs {
-    #[command(flatten)]
-    pub render: RenderArgs,
-    /// How frames wait for the screen: fifo (vertical blank; always offered), fifo-relaxed,
-    /// mailbox, immediate.
-    #[arg(long, value_enum, default_value = "fifo")]
-    pub present_mode: PresentModeArg,
-    /// Write the last presented image (PNG) when the viewer exits.
-    #[arg(long, value_name = "FILE.png")]
-    pub screenshot: Option<PathBuf>,
-    /// Leave out the panel (settings and timings drawn over the image; `h` toggles it).
-    #[arg(long)]
-    pub no_panel: bool,
-    /// Run the commands of this file, one per line (orbit, pan, zoom, light, material, set,
-    /// frames, screenshot, resize, pause, trace, quit; see README "View").
-    #[arg(long, value_name = "FILE")]
-    pub script: Option<PathBuf>,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum PresentModeArg {
-    Fifo,
-    FifoRelaxed,
-    Mailbox,
-    Immediate,
-}
-
-impl From<PresentModeArg> for PresentMode {
-    fn from(m: PresentModeArg) -> PresentMode {
-        match m {
-            PresentModeArg::Fifo => PresentMode::Fifo,
-            PresentModeArg::FifoRelaxed => PresentMode::FifoRelaxed,
-            PresentModeArg::Mailbox => PresentMode::Mailbox,
-            PresentModeArg::Immediate => PresentMode::Immediate,
-        }
-    }
-}
+use schedule::{FrameKind, Schedule, Turn, STEP_BUDGET};
+use state::{Applied, ViewState};
 
 /// Whether the environment names a window system at all (X11 or Wayland).
 fn has_window_system() -> bool {
@@ -122,7 +88,7 @@ pub fn run(args: &ViewArgs) -> Result<i32> {
         return Err(e);
     }
     Ok(match validation {
-        Some((validating, counts)) => validation_exit_code(validating, &counts),
+        Some((validating, counts)) => counts.exit_code(validating),
         None => 0,
     })
 }
@@ -247,49 +213,10 @@ impl ApplicationHandler for App<'_> {
     }
 }
 
-/// When the event loop should come round to the viewer again.
-enum Turn {
-    Now,
-    At(Instant),
-    OnInput,
-}
-
-/// Input this recent counts as an ongoing interaction: frames are previews until it is older.
-const INTERACTION_HOLD: Duration = Duration::from_millis(300);
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum FrameKind {
-    /// At a fraction of the window's size, while the user interacts.
-    Preview,
-    Full,
-}
-
-impl FrameKind {
-    fn name(self) -> &'static str {
-        match self {
-            FrameKind::Preview => "preview",
-            FrameKind::Full => "refined",
-        }
-    }
-}
-
-/// Previews aim at this wall time (their size adapts).
-const PREVIEW_TARGET: Duration = Duration::from_millis(250);
-
-/// Full frames faster than this need no previews.
-const FAST_FRAME_S: f64 = 0.05;
-
-/// Tiles are halved while one takes longer than STEP_BUDGET, down to this side.
-const MIN_TILE: u32 = 16;
-
 /// The first tile side on a CPU device: a 64×64 tile of the default scene shades in about 15 ms
 /// on lavapipe (2 cores), well inside STEP_BUDGET, and each tile is a draw of its own, so smaller
 /// tiles would spend the frame on draws (tiles of 16 took twice the shading time of one draw).
 const CPU_TILE: u32 = 64;
-
-/// Shading work per turn of the event loop while a frame is refined, so that input is handled
-/// about every 100 ms even when a full frame takes seconds (lavapipe).
-const STEP_BUDGET: Duration = Duration::from_millis(80);
 
 /// The renderer's shading submissions in the window: short, to fit STEP_BUDGET.
 const SUBMISSION_TARGET_S: f64 = 0.04;
@@ -327,21 +254,22 @@ struct PanelNumbers {
 
 fn panel_state(
     numbers: &PanelNumbers,
-    subsurface: &SubsurfaceOptions,
+    view: &ViewState,
     renderer: &Renderer,
     exposure: Option<f32>,
     playing: Option<bool>,
 ) -> panel::PanelState {
+    let d = &view.desc;
     panel::PanelState {
-        material: subsurface.material.clone(),
-        model: subsurface.model,
-        epsilon: subsurface.epsilon,
-        samples: renderer.hierarchy.point_count,
+        material: view.material().clone(),
+        model: d.integration.model,
+        epsilon: d.integration.epsilon,
+        samples: view.world.objects[0].samples.or(renderer.point_count()).unwrap_or(0),
         exposure,
-        specular: subsurface.specular,
-        roughness: subsurface.roughness,
-        brute_force: subsurface.brute_force,
-        show: renderer.show(),
+        specular: d.specular,
+        roughness: d.roughness,
+        brute_force: d.integration.brute_force,
+        show: d.show,
         playing,
         device: numbers.device.clone(),
         last_frame: numbers.last_frame.clone(),
@@ -362,10 +290,10 @@ struct Viewer {
     presenter: Presenter,
     renderer: Renderer,
     window: Arc<Window>,
-    scene: Scene,
-    subsurface: SubsurfaceOptions,
-    /// The object's centre: orbits turn about it, point lights too.
-    centre: Vec3,
+    /// What is shown, and the one route by which actions edit it.
+    view: ViewState,
+    /// When to render what.
+    schedule: Schedule,
     /// The window's size in pixels (zero when minimised).
     size: (u32, u32),
     script: VecDeque<ScriptLine>,
@@ -376,8 +304,6 @@ struct Viewer {
     /// Exit after this many presented frames (`--frames`).
     frames_limit: Option<u32>,
     presented: u32,
-    /// The scene changed since the last rendered frame.
-    dirty: bool,
     /// A rendered frame has not reached the window yet (skipped present, or never shown).
     unshown: bool,
     quit: bool,
@@ -389,27 +315,15 @@ struct Viewer {
     device_name: String,
     /// The frame being shaded over turns of the loop, what it is, and when it was begun.
     frame: Option<(FrameInProgress, FrameKind, Instant)>,
-    /// Previews are the window's size divided by this (adapted to PREVIEW_TARGET).
-    preview_divisor: u32,
-    /// Wall time of the last full frame.
-    last_full_frame_s: Option<f64>,
-    /// The last frame shown was a preview: refine once the interaction stops.
-    shown_preview: bool,
-    last_interaction: Option<Instant>,
-    /// The exposure in stops the keys step from (auto counts as 0).
-    exposure_stops: f32,
-    /// A mesh sequence or deformation, the step shown, and whether it plays.
+    /// A mesh sequence or deformation, and the step shown.
     animation: Option<crate::deform::Animation>,
     animation_frame: u32,
-    playing: bool,
     /// The panel asked to be drawn again.
     ui_repaint: bool,
     /// Changes made on the panel, applied at the start of the next turn.
     pending_actions: Vec<Action>,
     /// The numbers the panel shows about the last frames.
     panel_numbers: PanelNumbers,
-    /// Exposure as set (`None`: automatic).
-    exposure: Option<f32>,
     /// The longest turn of the event loop spent in the viewer (reported at exit).
     longest_turn: Duration,
     /// The same since the last frame was shown.
@@ -426,7 +340,7 @@ impl Viewer {
     fn new(
         event_loop: &ActiveEventLoop,
         args: &ViewArgs,
-        mut settings: RenderSettings,
+        settings: RenderSettings,
         script: VecDeque<ScriptLine>,
         frames_limit: Option<u32>,
     ) -> Result<Viewer> {
@@ -444,27 +358,20 @@ impl Viewer {
         let presenter = Presenter::new(&ctx, display, handle, (size.width, size.height), args.present_mode.into())?;
         log::info!("window {}x{}, swapchain format {:?}", size.width, size.height, presenter.surface_format());
 
-        let point_count = settings.point_count(&ctx)?;
-        // The window's size: the renderer follows it from the first frame on.
-        (settings.width, settings.height) = (size.width.max(1), size.height.max(1));
-        let options = settings.frame_options(point_count);
-        let RenderSettings { scene, subsurface, .. } = settings;
-        let mut renderer = Renderer::new(ctx, &scene, options)?;
+        let RenderSettings { world, mut desc, profile } = settings;
+        // The window's size: frames follow it from the first on.
+        (desc.width, desc.height) = (size.width.max(1), size.height.max(1));
+        let mut renderer = Renderer::new(ctx, profile)?;
         renderer.set_submission_target(SUBMISSION_TARGET_S);
         if renderer.ctx.info.device_type == ash::vk::PhysicalDeviceType::CPU {
             // A CPU device (lavapipe) takes most of a second per frame: tiles small enough for a
             // turn of the event loop from the first frame on (they adapt further, see MIN_TILE).
             renderer.set_tile_size(CPU_TILE);
         }
-        let (centre, _) = crate::scene::bounding_sphere(&scene.mesh.positions);
         let device_label = device_name.clone();
-        let animation = crate::deform::Animation::new(
-            &SceneSettings::from_args(r).mesh_spec(),
-            &scene.mesh,
-            r.deform,
-            r.deform_period,
-            r.up,
-        )?;
+        let mesh_spec = SceneSettings::from_args(r).mesh_spec();
+        let animation =
+            crate::deform::Animation::new(&mesh_spec, &world.objects[0].mesh, r.deform, r.deform_period, r.up)?;
         let ui = if args.no_panel {
             None
         } else {
@@ -485,16 +392,14 @@ impl Viewer {
             presenter,
             renderer,
             window,
-            scene,
-            subsurface,
-            centre,
+            view: ViewState::new(world, desc),
+            schedule: Schedule::default(),
             size: (size.width, size.height),
             script,
             script_frames: 0,
             pending_resize: None,
             frames_limit,
             presented: 0,
-            dirty: true,
             unshown: false,
             quit: false,
             input: Input::default(),
@@ -503,33 +408,22 @@ impl Viewer {
             fps: FrameClock { last: None, seconds: 0.0 },
             device_name,
             frame: None,
-            preview_divisor: 4,
-            last_full_frame_s: None,
-            shown_preview: false,
-            last_interaction: None,
-            exposure_stops: r.exposure.unwrap_or(0.0),
             animation,
             animation_frame: 0,
-            playing: true,
             ui,
             ui_repaint: true,
             pending_actions: Vec::new(),
             panel_numbers: PanelNumbers { device: device_label, ..Default::default() },
-            exposure: r.exposure,
             longest_turn: Duration::ZERO,
             longest_turn_of_frame: Duration::ZERO,
         })
     }
 
-    fn interacting(&self) -> bool {
-        self.last_interaction.is_some_and(|t| t.elapsed() < INTERACTION_HOLD)
-    }
-
     /// Whether a new frame is asked for (not counting the refinement of a preview).
     fn new_frame_wanted(&self) -> bool {
         let limit_left = self.frames_limit.is_some_and(|n| self.presented < n);
-        let playing = self.playing && self.animation.is_some();
-        self.dirty || self.script_frames > 0 || limit_left || self.trace.is_some() || playing
+        let playing = self.view.playing && self.animation.is_some();
+        self.schedule.is_dirty() || self.script_frames > 0 || limit_left || self.trace.is_some() || playing
     }
 
     /// When the loop should come round again.
@@ -554,11 +448,7 @@ impl Viewer {
         {
             return Turn::Now;
         }
-        match (self.shown_preview, self.last_interaction) {
-            (true, Some(t)) if self.interacting() => Turn::At(t + INTERACTION_HOLD),
-            (true, _) => Turn::Now,
-            _ => Turn::OnInput,
-        }
+        self.schedule.idle_turn(Instant::now())
     }
 
     fn minimised(&self) -> bool {
@@ -571,7 +461,7 @@ impl Viewer {
             self.size = (width, height);
             self.presenter.resize(width, height);
             if !self.minimised() {
-                self.dirty = true;
+                self.schedule.changed();
             }
         }
         if self.pending_resize.is_some_and(|(want, _)| want == (width, height)) {
@@ -616,6 +506,7 @@ impl Viewer {
 
     fn key(&mut self, key: &Key) -> Result<()> {
         let shift = self.input.modifiers.shift_key();
+        let d = &self.view.desc;
         let step = 5.0;
         let action = match key {
             Key::Named(NamedKey::Escape) => Action::Quit,
@@ -647,22 +538,19 @@ impl Viewer {
                 // The panel's settings, from the keys.
                 "m" => {
                     let presets = crate::materials::Material::presets();
-                    let now = presets.iter().position(|m| m.name == self.subsurface.material.name).unwrap_or(0);
+                    let now = presets.iter().position(|m| m.name == self.view.material().name).unwrap_or(0);
                     Action::Material(
                         presets[(now + if shift { presets.len() - 1 } else { 1 }) % presets.len()].name.clone(),
                     )
                 }
-                "d" => Action::Set(Setting::Model(match self.subsurface.model {
-                    crate::physics::Model::Directional => crate::physics::Model::Dipole,
-                    crate::physics::Model::Dipole => crate::physics::Model::Directional,
-                })),
-                "b" => Action::Set(Setting::BruteForce(!self.subsurface.brute_force)),
-                "s" => Action::Set(Setting::Specular(!self.subsurface.specular)),
-                "[" => Action::Set(Setting::Epsilon(self.subsurface.epsilon / 2.0)),
-                "]" => Action::Set(Setting::Epsilon((self.subsurface.epsilon * 2.0).max(1e-3))),
-                "," => Action::Set(Setting::Exposure(Some(self.exposure_stops - 0.5))),
-                "." => Action::Set(Setting::Exposure(Some(self.exposure_stops + 0.5))),
-                "v" => Action::Set(Setting::Show(match self.renderer.show() {
+                "d" => Action::Set(Setting::Model(d.integration.model.next())),
+                "b" => Action::Set(Setting::BruteForce(!d.integration.brute_force)),
+                "s" => Action::Set(Setting::Specular(!d.specular)),
+                "[" => Action::Set(Setting::Epsilon(d.integration.epsilon / 2.0)),
+                "]" => Action::Set(Setting::Epsilon((d.integration.epsilon * 2.0).max(1e-3))),
+                "," => Action::Set(Setting::Exposure(Some(self.view.exposure_stops - 0.5))),
+                "." => Action::Set(Setting::Exposure(Some(self.view.exposure_stops + 0.5))),
+                "v" => Action::Set(Setting::Show(match d.show {
                     Show::Shading => Show::Samples,
                     Show::Samples => Show::Tree(2),
                     Show::Tree(l) if l < 8 => Show::Tree(l + 2),
@@ -678,64 +566,21 @@ impl Viewer {
 
     /// An action from the mouse or the keys: frames are previews while these keep coming.
     fn interact(&mut self, action: Action) -> Result<()> {
-        self.last_interaction = Some(Instant::now());
+        self.schedule.interacted(Instant::now());
         self.apply(action)
     }
 
-    /// Applies one action: the one path for scripts, keys and the mouse.
+    /// Applies one action: what is drawn changes through [`ViewState::apply`] alone; the rest is
+    /// the window's.
     fn apply(&mut self, action: Action) -> Result<()> {
+        let action = match self.view.apply(action)? {
+            Applied::Edited => {
+                self.schedule.changed();
+                return Ok(());
+            }
+            Applied::Window(action) => action,
+        };
         match action {
-            Action::Orbit { right_deg, up_deg } => {
-                controls::orbit(&mut self.scene.camera, right_deg, up_deg);
-                self.dirty = true;
-            }
-            Action::Pan { right, up } => {
-                controls::pan(&mut self.scene.camera, right, up);
-                self.dirty = true;
-            }
-            Action::Zoom(f) => {
-                controls::zoom(&mut self.scene.camera, f);
-                self.dirty = true;
-            }
-            Action::TurnLights { right_deg, up_deg } => {
-                controls::turn_lights(&mut self.scene.lights, &self.scene.camera, self.centre, right_deg, up_deg);
-                self.dirty = true;
-            }
-            Action::SetLight(light) => {
-                self.scene.lights[0] = light;
-                self.dirty = true;
-            }
-            Action::Material(name) => {
-                self.subsurface.material = crate::materials::Material::find(&name)?;
-                self.update_subsurface()?;
-            }
-            Action::Set(setting) => {
-                // Kept to go back to when the change is refused (e.g. g ≥ 1 typed on the panel).
-                let before = (self.subsurface.material.clone(), self.subsurface.epsilon, self.subsurface.roughness);
-                let s = &mut self.subsurface;
-                match setting {
-                    Setting::Epsilon(e) => s.epsilon = e,
-                    Setting::Exposure(stops) => {
-                        self.exposure_stops = stops.unwrap_or(0.0);
-                        self.exposure = stops;
-                        self.renderer.set_exposure(stops.map(Exposure::Stops).unwrap_or(Exposure::Auto))
-                    }
-                    Setting::Specular(on) => s.specular = on,
-                    Setting::Roughness(r) => s.roughness = r,
-                    Setting::Model(m) => s.model = m,
-                    Setting::BruteForce(on) => s.brute_force = on,
-                    Setting::SigmaA(v) => s.material.sigma_a = v,
-                    Setting::SigmaS(v) => s.material.sigma_s = v,
-                    Setting::G(v) => s.material.g = v,
-                    Setting::Eta(v) => s.material.eta = v,
-                    Setting::Samples(n) => self.renderer.set_point_count(n, &self.scene.mesh)?,
-                    Setting::Show(show) => self.renderer.set_show(show),
-                }
-                if let Err(e) = self.subsurface.material.validate().and_then(|_| self.update_subsurface()) {
-                    (self.subsurface.material, self.subsurface.epsilon, self.subsurface.roughness) = before;
-                    return Err(e);
-                }
-            }
             Action::Frames(n) => self.script_frames = n,
             Action::Drag(kind, dx, dy) => self.drag(kind, dx, dy)?,
             Action::Screenshot(path) => {
@@ -763,28 +608,25 @@ impl Viewer {
                     }
                 }
             }
-            Action::TogglePause => self.playing = !self.playing,
             Action::Trace(frames, path) => {
                 self.trace = Some((frames, Vec::new(), path));
-                self.dirty = true;
+                self.schedule.changed();
             }
             Action::Quit => self.quit = true,
+            // Edits: ViewState::apply took them.
+            _ => {}
         }
-        Ok(())
-    }
-
-    fn update_subsurface(&mut self) -> Result<()> {
-        self.renderer.set_subsurface(&self.subsurface, self.scene.mm_per_unit)?;
-        self.dirty = true;
         Ok(())
     }
 
     /// Makes sure that the last frame shown is the current scene at the window's size.
     fn refine_now(&mut self) -> Result<()> {
-        if self.dirty || matches!(self.frame, Some((_, FrameKind::Preview, _))) {
+        if self.schedule.is_dirty() || matches!(self.frame, Some((_, FrameKind::Preview, _))) {
             self.frame = None;
+            self.schedule.dropped();
         }
-        if self.frame.is_none() && (self.dirty || self.shown_preview || self.source.is_none()) {
+        if self.frame.is_none() && (self.schedule.is_dirty() || self.schedule.shown_preview() || self.source.is_none())
+        {
             self.begin(FrameKind::Full)?;
         }
         if self.frame.is_some() {
@@ -834,16 +676,14 @@ impl Viewer {
             self.script_frames = self.script_frames.saturating_sub(1);
             return Ok(());
         }
-        if self.dirty && matches!(self.frame, Some((_, FrameKind::Full, _))) {
+        let plan = self.schedule.plan(Instant::now(), self.new_frame_wanted());
+        if plan.drop {
             // A full frame of an old view is dropped; a preview is short and is finished.
             self.frame = None;
+            self.schedule.dropped();
         }
-        if self.frame.is_none() {
-            if self.dirty && self.interacting() && !self.full_frames_are_fast() {
-                self.begin(FrameKind::Preview)?;
-            } else if self.new_frame_wanted() || self.shown_preview {
-                self.begin(FrameKind::Full)?;
-            }
+        if let Some(kind) = plan.begin {
+            self.begin(kind)?;
         }
         if self.frame.is_some() {
             let finished = self.shade(Some(STEP_BUDGET))?;
@@ -861,31 +701,22 @@ impl Viewer {
         Ok(())
     }
 
-    /// A full frame took so little that previews would not help (a GPU).
-    fn full_frames_are_fast(&self) -> bool {
-        self.last_full_frame_s.is_some_and(|s| s < FAST_FRAME_S)
-    }
-
     /// Starts a frame of the current view: the window's size, or a fraction of it for a preview.
     fn begin(&mut self, kind: FrameKind) -> Result<()> {
-        let (w, h) = self.size;
-        let (w, h) = match kind {
-            FrameKind::Full => (w, h),
-            FrameKind::Preview => ((w / self.preview_divisor).max(1), (h / self.preview_divisor).max(1)),
-        };
-        self.renderer.set_size(w, h)?;
         let started = Instant::now();
-        if let Some(animation) = self.animation.as_ref().filter(|_| self.playing) {
+        if let Some(animation) = self.animation.as_ref().filter(|_| self.view.playing) {
             // This step of the sequence or deformation (normals recomputed); the next frame shows
             // the next.
-            self.scene.mesh = animation.mesh(self.animation_frame)?;
-            self.renderer.set_mesh(&self.scene.mesh)?;
+            self.view.world.objects[0].mesh = animation.mesh(self.animation_frame)?;
             self.animation_frame += 1;
         }
-        let frame = self.renderer.begin_frame(&self.scene)?;
+        // The frame is of the window's size, or a fraction of it for a preview.
+        let mut desc = self.view.desc.clone();
+        (desc.width, desc.height) = self.schedule.frame_size(kind, self.size);
+        let frame = self.renderer.begin_frame(&self.view.world, &desc)?;
         log::debug!("{kind:?} frame begun (hierarchy, depth) in {:.0} ms", started.elapsed().as_secs_f64() * 1e3);
         self.frame = Some((frame, kind, started));
-        self.dirty = false;
+        self.schedule.begun(kind);
         Ok(())
     }
 
@@ -913,28 +744,13 @@ impl Viewer {
         let (frame, _, _) = self.frame.take().expect("in progress");
         // One tile longer than a turn's budget: smaller tiles from the next frame on (not on a
         // device that shades whole frames in one go).
-        let tile = self.renderer.tile_size();
-        if frame.longest_unit_seconds() > STEP_BUDGET.as_secs_f64() && tile > MIN_TILE {
-            self.renderer.set_tile_size((tile / 2).max(MIN_TILE));
-            log::info!("tiles of {} pixels, so that one takes under {} ms", tile / 2, STEP_BUDGET.as_millis());
+        if let Some(tile) = schedule::next_tile(self.renderer.tile_size(), frame.longest_unit_seconds()) {
+            self.renderer.set_tile_size(tile);
+            log::info!("tiles of {tile} pixels, so that one takes under {} ms", STEP_BUDGET.as_millis());
         }
         let scopes = self.renderer.finish_frame(frame)?;
         let seconds = started.elapsed().as_secs_f64();
-        match kind {
-            FrameKind::Full => {
-                self.last_full_frame_s = Some(seconds);
-                self.shown_preview = false;
-            }
-            FrameKind::Preview => {
-                // Previews of about PREVIEW_TARGET: coarser when slower, finer when faster.
-                if seconds > 2.0 * PREVIEW_TARGET.as_secs_f64() && self.preview_divisor < 16 {
-                    self.preview_divisor *= 2;
-                } else if seconds < 0.5 * PREVIEW_TARGET.as_secs_f64() && self.preview_divisor > 2 {
-                    self.preview_divisor /= 2;
-                }
-                self.shown_preview = true;
-            }
-        }
+        self.schedule.finished(seconds);
         self.frame_rendered(scopes, kind.name(), seconds)?;
         self.present()?;
         Ok(true)
@@ -947,7 +763,7 @@ impl Viewer {
             frames.push(scopes.clone());
             *left -= 1;
             if *left == 0 {
-                let report = Self::report(&self.device_name, std::mem::take(frames));
+                let report = ProfileReport::from_frames(&self.device_name, std::mem::take(frames));
                 std::fs::write(&*path, crate::profiling::chrome_trace_json(&report))
                     .map_err(|e| runtime!("trace {}: {e}", path.display()))?;
                 eprintln!("wrote {} ({} frames)", path.display(), report.frames.len());
@@ -964,7 +780,7 @@ impl Viewer {
             self.fps.seconds = (now - last).as_secs_f64();
         }
         let extent = self.renderer.extent();
-        let points = self.renderer.hierarchy.point_count;
+        let points = self.renderer.point_count().unwrap_or(0);
         let work = self.renderer.work()?;
         let per_pixel = if work.pixels > 0 {
             let px = work.pixels as f64;
@@ -1009,19 +825,6 @@ impl Viewer {
         Ok(())
     }
 
-    fn report(device_name: &str, frames: Vec<Vec<TimedScope>>) -> crate::profiling::ProfileReport {
-        use crate::profiling::{ProfileReport, Scope};
-        ProfileReport {
-            device: device_name.to_string(),
-            frames: frames
-                .into_iter()
-                .map(|f| {
-                    f.into_iter().map(|s| Scope { name: s.name, begin_ns: s.begin_ns, end_ns: s.end_ns }).collect()
-                })
-                .collect(),
-        }
-    }
-
     /// Shows the last finished frame (copied into the window's image once) with the panel.
     fn present(&mut self) -> Result<()> {
         let ctx = &self.renderer.ctx;
@@ -1047,10 +850,14 @@ impl Viewer {
         // The tone-mapped buffer is copied once per finished frame: while the next is in progress
         // it may be of another size.
         let copy = |rec: &mut vk::Recorder| if fresh { rec.copy_buffer_to_image(ldr, source) } else { Ok(()) };
-        let playing = self.animation.as_ref().map(|_| self.playing);
+        let playing = self.animation.as_ref().map(|_| self.view.playing);
+        let exposure = match self.view.desc.exposure {
+            crate::output::Exposure::Stops(s) => Some(s),
+            crate::output::Exposure::Auto => None,
+        };
         let shown = match self.ui.as_mut().filter(|ui| ui.shown) {
             Some(ui) => {
-                let state = panel_state(&self.panel_numbers, &self.subsurface, &self.renderer, self.exposure, playing);
+                let state = panel_state(&self.panel_numbers, &self.view, &self.renderer, exposure, playing);
                 let input = ui.state.take_egui_input(&self.window);
                 let mut actions = Vec::new();
                 let output = ui.state.egui_ctx().run_ui(input, |ui| panel::draw(ui.ctx(), &state, &mut actions));

@@ -4,7 +4,7 @@
 use egui::{Color32, RichText, SliderClamping::Edits};
 
 use super::controls::{Action, Setting};
-use crate::frame::Show;
+use crate::frame_desc::Show;
 use crate::physics::Model;
 
 /// What the panel shows: the current settings and the last frames' numbers.
@@ -88,8 +88,9 @@ pub fn draw(ctx: &egui::Context, s: &PanelState, actions: &mut Vec<Action>) {
         egui::CollapsingHeader::new("Rendering").default_open(true).show(ui, |ui| {
             let mut model = s.model;
             ui.horizontal(|ui| {
-                ui.radio_value(&mut model, Model::Directional, "directional");
-                ui.radio_value(&mut model, Model::Dipole, "classical");
+                for entry in crate::models::MODELS {
+                    ui.radio_value(&mut model, entry.model, entry.label);
+                }
             });
             if model != s.model {
                 actions.push(Action::Set(Setting::Model(model)));

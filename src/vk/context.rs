@@ -30,6 +30,20 @@ impl ValidationCounts {
     pub fn total(&self) -> u32 {
         self.warnings.load(Ordering::SeqCst) + self.errors.load(Ordering::SeqCst)
     }
+
+    /// A command's exit code: 1 (with a summary on stderr) when the validation layer reported
+    /// anything, else 0.
+    pub fn exit_code(&self, validating: bool) -> i32 {
+        let (w, e) = (self.warnings.load(Ordering::SeqCst), self.errors.load(Ordering::SeqCst));
+        if w + e > 0 {
+            crate::note!("error: validation reported {e} error(s) and {w} warning(s)");
+            return 1;
+        }
+        if validating {
+            log::info!("validation: no messages");
+        }
+        0
+    }
 }
 
 #[derive(Clone, Debug, Default)]

@@ -35,9 +35,8 @@ pub fn assert_clean(counts: &ValidationCounts) {
 /// drops it and then calls [`assert_clean`] on the counts.
 pub fn render_frame(settings: &RenderSettings) -> (Renderer, Arc<ValidationCounts>) {
     let (ctx, counts) = validated_context();
-    let point_count = settings.point_count(&ctx).expect("sample count");
-    let mut renderer = Renderer::new(ctx, &settings.scene, settings.frame_options(point_count)).expect("renderer");
-    renderer.render_frame(&settings.scene).expect("frame");
+    let mut renderer = Renderer::new(ctx, settings.profile).expect("renderer");
+    renderer.render_frame(&settings.world, &settings.desc).expect("frame");
     (renderer, counts)
 }
 

@@ -1,0 +1,205 @@
+//! What one frame draws of the world: the camera, the lights, the image, how the subsurface term
+//! is integrated and what is shown. A plain value with its defaults and one [`FrameDesc::validate`]
+//! (every range check of these settings lives there). [`crate::frame::Renderer::begin_frame`]
+//! copies it: a frame in flight never sees a later edit.
+
+use glam::Vec3;
+
+use crate::bad_input;
+use crate::error::Result;
+use crate::output::Exposure;
+use crate::physics::{Diffusion, Model};
+use crate::scene::{Camera, Light};
+
+/// A node is used whole when its area / squared distance is below this (`--epsilon`): with its two
+/// sigma points per light, 0.2 gives 0.95% relative RMSE against brute force on the back-lit bunny
+/// and 0.2–0.4% front-lit, unbiased, at about the cost 0.1 had with one source per node (0.65%,
+/// biased low by 0.6–1.6%). See the sweep in BENCHMARKS.md.
+pub const DEFAULT_EPSILON: f32 = 0.2;
+
+/// The default roughness of the microfacet reflection (`--roughness`).
+pub const DEFAULT_ROUGHNESS: f32 = 0.35;
+
+/// The default shadow-map resolution per light (per cube face for point lights).
+pub const DEFAULT_SHADOW_RESOLUTION: u32 = 1024;
+
+/// The shadow-map resolutions accepted (`--shadow-resolution`).
+pub const SHADOW_RESOLUTION_RANGE: (u32, u32) = (16, 8192);
+
+/// The largest coordinate accepted for --eye, --target and point lights: squared distances must
+/// stay finite in f32.
+pub const MAX_COORDINATE: f32 = 1e15;
+
+/// What to draw: the shaded mesh, or a debug view instead of it (the subsurface pass is skipped).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Show {
+    Shading,
+    /// The sample points coloured by irradiance.
+    Samples,
+    /// The boxes of the tree nodes this many levels below the root.
+    Tree(u32),
+}
+
+/// How the subsurface term is integrated.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Integration {
+    pub model: Model,
+    pub diffusion: Diffusion,
+    /// A node is used whole when its area / squared distance is below this.
+    pub epsilon: f32,
+    /// Sum over every point instead of walking the tree (the reference).
+    pub brute_force: bool,
+}
+
+impl Default for Integration {
+    fn default() -> Self {
+        Integration {
+            model: Model::Directional,
+            diffusion: Diffusion::Classical,
+            epsilon: DEFAULT_EPSILON,
+            brute_force: false,
+        }
+    }
+}
+
+/// One frame's description (see the module's documentation).
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrameDesc {
+    pub camera: Camera,
+    /// Between 1 and [`crate::gpu::MAX_LIGHTS`].
+    pub lights: Vec<Light>,
+    pub width: u32,
+    pub height: u32,
+    pub integration: Integration,
+    /// Add the surface's microfacet reflection (`--no-specular` turns it off).
+    pub specular: bool,
+    /// Roughness of the microfacet lobe (α = roughness²), in (0, 1].
+    pub roughness: f32,
+    pub show: Show,
+    /// Of the tone-mapped 8-bit image (PNG); the HDR image is untouched.
+    pub exposure: Exposure,
+    /// Count nodes visited and points evaluated per pixel on the GPU (costs atomics).
+    pub count_work: bool,
+    /// Shadow-map resolution per light (per cube face for point lights).
+    pub shadow_resolution: u32,
+}
+
+impl FrameDesc {
+    /// `camera` and `lights` with the command line's defaults for everything else: 512×512, the
+    /// directional dipole with classical diffusion at the default ε, specular on, automatic
+    /// exposure, work not counted.
+    pub fn new(camera: Camera, lights: Vec<Light>) -> FrameDesc {
+        FrameDesc {
+            camera,
+            lights,
+            width: 512,
+            height: 512,
+            integration: Integration::default(),
+            specular: true,
+            roughness: DEFAULT_ROUGHNESS,
+            show: Show::Shading,
+            exposure: Exposure::Auto,
+            count_work: false,
+            shadow_resolution: DEFAULT_SHADOW_RESOLUTION,
+        }
+    }
+
+    /// Every check of these settings, with the flag each comes from named. The device's own
+    /// limits (largest image, memory) are checked when the renderer makes what they size.
+    pub fn validate(&self) -> Result<()> {
+        let e = self.integration.epsilon;
+        if !(e.is_finite() && e >= 0.0) {
+            return Err(bad_input!("--epsilon {e}: must be a finite number ≥ 0"));
+        }
+        check_roughness(self.roughness, "--roughness")?;
+        if self.width == 0 || self.height == 0 {
+            return Err(bad_input!("image size {}x{}: width and height must be at least 1", self.width, self.height));
+        }
+        let (lo, hi) = SHADOW_RESOLUTION_RANGE;
+        if !(lo..=hi).contains(&self.shadow_resolution) {
+            return Err(bad_input!("--shadow-resolution {}: must be between {lo} and {hi}", self.shadow_resolution));
+        }
+        check_camera(&self.camera)?;
+        check_lights(&self.lights)
+    }
+
+    /// The view-projection matrix of this frame's camera around `bounds`.
+    pub fn view_projection(&self, bounds: (Vec3, Vec3)) -> glam::Mat4 {
+        self.camera.view_projection(self.width as f32 / self.height as f32, bounds)
+    }
+}
+
+/// The camera's own checks, and its coordinates within [`MAX_COORDINATE`].
+pub fn check_camera(camera: &Camera) -> Result<()> {
+    for (flag, p) in [("--eye", camera.eye), ("--target", camera.target)] {
+        if p.abs().max_element() > MAX_COORDINATE {
+            return Err(bad_input!("{flag} {p}: coordinates must be within ±{MAX_COORDINATE:e}"));
+        }
+    }
+    camera.validate()
+}
+
+/// Between 1 and [`crate::gpu::MAX_LIGHTS`] lights, each valid, point lights within
+/// [`MAX_COORDINATE`].
+pub fn check_lights(lights: &[Light]) -> Result<()> {
+    for light in lights {
+        if let Light::Point { position, .. } = light {
+            if position.abs().max_element() > MAX_COORDINATE {
+                return Err(bad_input!("--light point:{position}: coordinates must be within ±{MAX_COORDINATE:e}"));
+            }
+        }
+    }
+    if lights.is_empty() || lights.len() > crate::gpu::MAX_LIGHTS {
+        return Err(bad_input!("--light: at most {} lights, {} given", crate::gpu::MAX_LIGHTS, lights.len()));
+    }
+    lights.iter().try_for_each(Light::validate)
+}
+
+/// Refuses a roughness outside (0, 1]; `what` names it in the message (`--roughness`, `roughness`).
+pub fn check_roughness(roughness: f32, what: &str) -> Result<()> {
+    if !(roughness > 0.0 && roughness <= 1.0) {
+        return Err(bad_input!("{what} {roughness}: must be in (0, 1]"));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn desc() -> FrameDesc {
+        let camera = Camera { eye: Vec3::new(0.0, 0.0, 5.0), target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 40.0 };
+        FrameDesc::new(camera, vec![Light::Directional { toward: Vec3::Y, irradiance: Vec3::ONE }])
+    }
+
+    #[test]
+    fn the_defaults_are_valid() {
+        desc().validate().unwrap();
+    }
+
+    /// Each range check refuses, naming its flag.
+    #[test]
+    fn every_range_is_checked_once_here() {
+        let cases: Vec<(&str, Box<dyn Fn(&mut FrameDesc)>)> = vec![
+            ("--epsilon", Box::new(|d| d.integration.epsilon = f32::NAN)),
+            ("--epsilon", Box::new(|d| d.integration.epsilon = -1.0)),
+            ("--epsilon", Box::new(|d| d.integration.epsilon = f32::INFINITY)),
+            ("--roughness", Box::new(|d| d.roughness = 0.0)),
+            ("--roughness", Box::new(|d| d.roughness = 1.5)),
+            ("image size", Box::new(|d| d.width = 0)),
+            ("--shadow-resolution", Box::new(|d| d.shadow_resolution = 8)),
+            ("--eye", Box::new(|d| d.camera.eye = Vec3::splat(1e16))),
+            ("--fov", Box::new(|d| d.camera.fov_y_deg = 1e-37)),
+            ("--light", Box::new(|d| d.lights.clear())),
+            ("--light", Box::new(|d| d.lights = vec![d.lights[0]; crate::gpu::MAX_LIGHTS + 1])),
+            ("--light point", Box::new(|d| d.lights[0] = Light::Point { position: Vec3::X * 1e16, intensity: Vec3::ONE })),
+            ("light intensity", Box::new(|d| d.lights[0] = Light::Point { position: Vec3::X, intensity: -Vec3::ONE })),
+        ];
+        for (needle, edit) in cases {
+            let mut d = desc();
+            edit(&mut d);
+            let message = d.validate().expect_err(needle).to_string();
+            assert!(message.contains(needle), "{needle}: {message}");
+        }
+    }
+}

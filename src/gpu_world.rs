@@ -1,0 +1,226 @@
+//! The GPU's copy of the [`World`]: per object its mesh buffers, its hierarchy (points, tree,
+//! shadow maps) and its shading parameters. [`GpuWorld::sync`] is the one place that decides what
+//! to make again when the world or the frame's lights change; the renderer calls it when a frame
+//! begins, never while one is in flight.
+
+use glam::Vec3;
+
+use crate::bad_input;
+use crate::budget::{self, FrameSizes};
+use crate::error::Result;
+use crate::frame_desc::FrameDesc;
+use crate::gpu::{GpuChannel, ObjectParams, SdTable};
+use crate::hierarchy::{self, Hierarchy, HierarchyOptions};
+use crate::materials::Material;
+use crate::mesh::Mesh;
+use crate::physics::Diffusion;
+use crate::scene::Light;
+use crate::vk::{self, Buffer, BufferUsageFlags, Context, MemoryLocation};
+use crate::world::World;
+
+/// One object on the GPU.
+pub struct GpuObject {
+    pub hierarchy: Hierarchy,
+    pub vertices: Buffer,
+    pub indices: Buffer,
+    pub index_count: u32,
+    /// The world mesh's box (the camera's near and far planes are fitted to it).
+    pub bounds: (Vec3, Vec3),
+    /// The material's constants and the tree's size (`ObjectParams`, a uniform buffer).
+    pub params: Buffer,
+    /// The classical dipole's Sd table (texels) for the material.
+    pub dipole_table: Buffer,
+    /// What the buffers above were made from.
+    made_from: MadeFrom,
+}
+
+/// What an object's GPU state was made from, to tell what changed.
+struct MadeFrom {
+    mesh: Mesh,
+    material: Material,
+    diffusion: Diffusion,
+    mm_per_unit: f32,
+    /// The sample count asked for (`None`: the default), and the count it resolved to.
+    samples: Option<u32>,
+}
+
+/// The world's objects on the GPU, and the light layout their hierarchies were made for.
+#[derive(Default)]
+pub struct GpuWorld {
+    pub objects: Vec<GpuObject>,
+    lights: Vec<Light>,
+    shadow_resolution: u32,
+}
+
+impl GpuWorld {
+    /// Makes the GPU's copy follow `world` and the lights of `desc`: a new hierarchy where the
+    /// sample count, the number of lights (or of shadow layers) or the shadow resolution changed;
+    /// new mesh buffers (and the hierarchy's triangle count and bounds) where the mesh changed;
+    /// new light records where only the lights moved; new parameters where the material, the
+    /// diffusion or the scale changed. Both are validated by the caller.
+    pub fn sync(&mut self, ctx: &Context, world: &World, desc: &FrameDesc) -> Result<()> {
+        if world.objects.len() > 1 {
+            return Err(bad_input!(
+                "{} objects: this renderer draws one translucent object per world so far",
+                world.objects.len()
+            ));
+        }
+        let layout = |lights: &[Light]| (lights.len(), FrameSizes::shadow_layers(lights));
+        let relayout = layout(&self.lights) != layout(&desc.lights) || self.shadow_resolution != desc.shadow_resolution;
+        let light_count = desc.lights.len() as u32;
+        // The sample counts first (each known before anything is made), and the frame's sizes
+        // against the device.
+        let mut point_counts = Vec::with_capacity(world.objects.len());
+        for (i, object) in world.objects.iter().enumerate() {
+            let kept = self.objects.get(i).filter(|g| g.made_from.samples == object.samples && !relayout);
+            point_counts.push(match (kept, object.samples) {
+                (Some(g), _) => g.hierarchy.point_count,
+                (None, Some(n)) => {
+                    hierarchy::check_point_count(ctx, n, light_count)?;
+                    n
+                }
+                (None, None) => {
+                    let mesh = object.world_mesh();
+                    hierarchy::default_point_count(ctx, &mesh, world.mm_per_unit, &object.material, light_count)
+                }
+            });
+        }
+        budget::check_frame(
+            ctx,
+            &FrameSizes {
+                width: desc.width,
+                height: desc.height,
+                shadow_resolution: desc.shadow_resolution,
+                shadow_layers: FrameSizes::shadow_layers(&desc.lights),
+                point_count: point_counts.iter().sum(),
+                light_count,
+            },
+        )?;
+        let diffusion = desc.integration.diffusion;
+        for (i, (object, &point_count)) in world.objects.iter().zip(&point_counts).enumerate() {
+            let mesh = object.world_mesh();
+            let options = HierarchyOptions {
+                point_count,
+                shadow_resolution: desc.shadow_resolution,
+                eta: object.material.eta as f32,
+            };
+            let Some(g) = self.objects.get_mut(i) else {
+                let made_from = MadeFrom {
+                    mesh: mesh.into_owned(),
+                    material: object.material.clone(),
+                    diffusion,
+                    mm_per_unit: world.mm_per_unit,
+                    samples: object.samples,
+                };
+                self.objects.push(GpuObject::new(ctx, &desc.lights, &options, made_from)?);
+                continue;
+            };
+            let mesh_changed = *mesh != g.made_from.mesh;
+            let remade = point_count != g.hierarchy.point_count || relayout;
+            // A window's copy of the last image may still be in flight; nothing else uses what
+            // is made again here (every frame's submissions have completed).
+            if mesh_changed || remade {
+                ctx.wait_idle()?;
+            }
+            if mesh_changed {
+                (g.vertices, g.indices, g.index_count) = upload_mesh(ctx, &mesh)?;
+                g.bounds = mesh.bounds();
+            }
+            let eta_changed = object.material.eta != g.made_from.material.eta;
+            if remade {
+                g.hierarchy = Hierarchy::new(ctx, &mesh, &desc.lights, &options)?;
+            } else {
+                if eta_changed {
+                    g.hierarchy.set_eta(options.eta)?;
+                }
+                if mesh_changed {
+                    g.hierarchy.set_mesh(ctx, &mesh, &desc.lights)?;
+                } else if desc.lights != self.lights {
+                    g.hierarchy.set_lights(&mesh, &desc.lights)?;
+                }
+            }
+            let params_changed = remade
+                || object.material != g.made_from.material
+                || diffusion != g.made_from.diffusion
+                || world.mm_per_unit != g.made_from.mm_per_unit;
+            if mesh_changed {
+                g.made_from.mesh = mesh.into_owned();
+            }
+            g.made_from.samples = object.samples;
+            if params_changed {
+                g.made_from.material = object.material.clone();
+                (g.made_from.diffusion, g.made_from.mm_per_unit) = (diffusion, world.mm_per_unit);
+                write_params(&mut g.params, &mut g.dipole_table, &g.made_from, point_count)?;
+            }
+        }
+        self.lights = desc.lights.clone();
+        self.shadow_resolution = desc.shadow_resolution;
+        Ok(())
+    }
+
+    /// The box around every object.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        self.objects
+            .iter()
+            .map(|o| o.bounds)
+            .fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), (a, b)| (lo.min(a), hi.max(b)))
+    }
+}
+
+impl GpuObject {
+    fn new(ctx: &Context, lights: &[Light], options: &HierarchyOptions, made_from: MadeFrom) -> Result<GpuObject> {
+        let mesh = &made_from.mesh;
+        let (vertices, indices, index_count) = upload_mesh(ctx, mesh)?;
+        let hierarchy = Hierarchy::new(ctx, mesh, lights, options)?;
+        let mut params = Buffer::new(
+            ctx,
+            "object parameters",
+            std::mem::size_of::<ObjectParams>() as u64,
+            BufferUsageFlags::UNIFORM_BUFFER,
+            MemoryLocation::CpuToGpu,
+        )?;
+        let mut dipole_table = Buffer::new(
+            ctx,
+            "dipole Sd table",
+            (crate::gpu::dipole_table::TABLE_SIZE * 16) as u64, // a header texel and TABLE_SIZE - 1 pairs
+            BufferUsageFlags::UNIFORM_TEXEL_BUFFER,
+            MemoryLocation::CpuToGpu,
+        )?;
+        write_params(&mut params, &mut dipole_table, &made_from, options.point_count)?;
+        Ok(GpuObject {
+            hierarchy,
+            vertices,
+            indices,
+            index_count,
+            bounds: made_from.mesh.bounds(),
+            params,
+            dipole_table,
+            made_from,
+        })
+    }
+}
+
+/// The vertex and index buffers of `mesh`, and its index count.
+fn upload_mesh(ctx: &Context, mesh: &Mesh) -> Result<(Buffer, Buffer, u32)> {
+    let index_count = u32::try_from(mesh.indices.len()).map_err(|_| bad_input!("mesh: too many indices"))?;
+    let usage = BufferUsageFlags::STORAGE_BUFFER;
+    let vertices = vk::upload_buffer(ctx, "vertices", &mesh.vertex_data(), usage | BufferUsageFlags::VERTEX_BUFFER)?;
+    let indices = vk::upload_buffer(ctx, "indices", &mesh.indices, usage | BufferUsageFlags::INDEX_BUFFER)?;
+    Ok((vertices, indices, index_count))
+}
+
+/// Writes an object's parameters and its dipole table from what it is made from.
+fn write_params(params: &mut Buffer, table: &mut Buffer, from: &MadeFrom, point_count: u32) -> Result<()> {
+    let constants = |c: usize| from.material.channel(c).constants(from.diffusion);
+    params.write(
+        0,
+        &[ObjectParams {
+            channels: [0, 1, 2].map(|c| GpuChannel::from(&constants(c))),
+            mm_per_unit: from.mm_per_unit,
+            point_count,
+            node_count: point_count - 1,
+            pad: 0,
+        }],
+    )?;
+    table.write(0, &SdTable::new(&[0, 1, 2].map(constants)).texels())
+}

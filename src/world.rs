@@ -1,0 +1,151 @@
+//! What is drawn: objects, each a mesh of one material placed by a transform, and the world's
+//! scale in millimetres. A plain value: the viewer, `render` and the tests edit it, and
+//! [`crate::gpu_world::GpuWorld::sync`] makes the GPU's copy follow it when a frame begins.
+
+use std::borrow::Cow;
+
+use glam::{Mat3, Mat4, Vec3};
+
+use crate::bad_input;
+use crate::error::Result;
+use crate::materials::Material;
+use crate::mesh::Mesh;
+
+/// The sizes (mm across) a mesh may have once --scale is applied: from a micrometre to a thousand
+/// kilometres, so that areas in mm² and the powers summed over them stay finite in f32.
+pub const SIZE_MM_LIMITS: (f64, f64) = (1e-3, 1e9);
+
+/// One translucent object.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Object {
+    /// In the object's own coordinates.
+    pub mesh: Mesh,
+    pub material: Material,
+    /// Object to world coordinates.
+    pub transform: Mat4,
+    /// Sample points over its surface (`None`: from the material's length scales and its area).
+    pub samples: Option<u32>,
+}
+
+impl Object {
+    /// `mesh` in `material`, where it is (identity transform), with the default sample count.
+    pub fn new(mesh: Mesh, material: Material) -> Object {
+        Object { mesh, material, transform: Mat4::IDENTITY, samples: None }
+    }
+
+    /// The mesh in world coordinates: positions by the transform, normals by its inverse
+    /// transpose, and the winding reversed by a mirroring transform so it stays counter-clockwise
+    /// seen from outside.
+    pub fn world_mesh(&self) -> Cow<'_, Mesh> {
+        if self.transform == Mat4::IDENTITY {
+            return Cow::Borrowed(&self.mesh);
+        }
+        let mut mesh = self.mesh.clone();
+        let normal_matrix = Mat3::from_mat4(self.transform).inverse().transpose();
+        for p in &mut mesh.positions {
+            *p = self.transform.transform_point3(*p);
+        }
+        for n in &mut mesh.normals {
+            *n = (normal_matrix * *n).normalize_or_zero();
+        }
+        if Mat3::from_mat4(self.transform).determinant() < 0.0 {
+            mesh.flip_winding();
+        }
+        Cow::Owned(mesh)
+    }
+}
+
+/// Everything drawn, in one scale.
+#[derive(Clone, Debug, PartialEq)]
+pub struct World {
+    pub objects: Vec<Object>,
+    /// Millimetres per world unit (materials are given per mm).
+    pub mm_per_unit: f32,
+}
+
+impl World {
+    /// A world of one object.
+    pub fn single(mesh: Mesh, material: Material, mm_per_unit: f32) -> World {
+        World { objects: vec![Object::new(mesh, material)], mm_per_unit }
+    }
+
+    /// Every check of the world, with the flag each comes from named: the scale, each mesh (and
+    /// its size in millimetres), each material, and the coefficients the GPU can hold in f32.
+    pub fn validate(&self) -> Result<()> {
+        if self.objects.is_empty() {
+            return Err(bad_input!("the world has no objects"));
+        }
+        for object in &self.objects {
+            if !object.transform.is_finite() || Mat3::from_mat4(object.transform).determinant() == 0.0 {
+                return Err(bad_input!("an object's transform is not finite or not invertible"));
+            }
+            check_geometry(&object.world_mesh(), self.mm_per_unit)?;
+            check_material(&object.material)?;
+        }
+        Ok(())
+    }
+
+    /// The box around every object, in world coordinates.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        self.objects.iter().map(|o| o.world_mesh().bounds()).fold(
+            (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
+            |(lo, hi), (a, b)| (lo.min(a), hi.max(b)),
+        )
+    }
+}
+
+/// A mesh at a scale: the scale itself, the mesh's own checks and its size in millimetres.
+pub fn check_geometry(mesh: &Mesh, mm_per_unit: f32) -> Result<()> {
+    if !(mm_per_unit.is_finite() && mm_per_unit > 0.0) {
+        return Err(bad_input!("--scale {mm_per_unit}: must be a positive number of millimetres per unit"));
+    }
+    let (_, radius) = crate::scene::bounding_sphere(&mesh.positions);
+    let size_mm = 2.0 * radius as f64 * mm_per_unit as f64;
+    if !(SIZE_MM_LIMITS.0..=SIZE_MM_LIMITS.1).contains(&size_mm) {
+        return Err(bad_input!(
+            "--scale {mm_per_unit}: the mesh would be {size_mm:.3e} mm across; it must be within [{:e}, {:e}] mm",
+            SIZE_MM_LIMITS.0,
+            SIZE_MM_LIMITS.1
+        ));
+    }
+    mesh.validate()
+}
+
+/// A material's own checks, and the coefficients the GPU can hold in f32 (see `bssrdf --gpu`).
+pub fn check_material(m: &Material) -> Result<()> {
+    m.validate()?;
+    let max = crate::bssrdf_csv::GPU_MAX_SIGMA_T;
+    if let Some(ch) = (0..3).find(|&c| m.sigma_a[c] + m.sigma_s[c] > max) {
+        return Err(bad_input!(
+            "--sigma-a/--sigma-s: σa + σs = {:e} /mm in channel {ch} is above {max:e}, beyond what rendering in f32 can hold",
+            m.sigma_a[ch] + m.sigma_s[ch],
+        ));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_mirroring_transform_keeps_the_mesh_outward() {
+        let mut object = Object::new(Mesh::sphere(1.0, 8), Material::find("marble").unwrap());
+        object.transform = Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0)) * Mat4::from_translation(Vec3::X * 3.0);
+        let mesh = object.world_mesh();
+        assert!(mesh.signed_volume() > 0.0, "outward winding after a mirror");
+        assert!(mesh.normal_agreement() > 0.0, "normals agree with the winding");
+        assert!((mesh.bounds().0.x + 4.0).abs() < 1e-5, "moved, then mirrored: {:?}", mesh.bounds());
+    }
+
+    #[test]
+    fn the_scale_and_the_coefficients_are_checked() {
+        let mut world = World::single(Mesh::sphere(1.0, 8), Material::find("marble").unwrap(), 10.0);
+        world.validate().unwrap();
+        world.mm_per_unit = 1e12;
+        assert!(world.validate().unwrap_err().to_string().contains("--scale"));
+        world.mm_per_unit = 10.0;
+        world.objects[0].material.sigma_s = [1e7; 3];
+        assert!(world.validate().unwrap_err().to_string().contains("f32"));
+    }
+}
