@@ -521,7 +521,9 @@ impl Renderer {
             // The subsurface term and the specular lobe per pixel, a batch of tiles at a time.
             self.ctx.submit(self.profiler.as_mut(), |rec| {
                 rec.scope("shade", |rec| {
-                    batch.iter().try_for_each(|unit| self.passes.shade.record_unit(rec, &inputs, &constants, unit, model))
+                    batch
+                        .iter()
+                        .try_for_each(|unit| self.passes.shade.record_unit(rec, &inputs, &constants, unit, model))
                 })
             })?;
             let seconds = submitted.elapsed().as_secs_f64();
@@ -573,7 +575,9 @@ impl Renderer {
         let exposure = desc.exposure;
         self.ctx.submit(self.profiler.as_mut(), |rec| {
             // Exposure from a luminance histogram, the filmic curve and sRGB, packed to 8 bits.
-            rec.scope("tone mapping", |rec| self.passes.tonemap.record(rec, &t.color, &self.histogram, &t.ldr, exposure))?;
+            rec.scope("tone mapping", |rec| {
+                self.passes.tonemap.record(rec, &t.color, &self.histogram, &t.ldr, exposure)
+            })?;
             // The 8-bit image, the linear radiance and the work counters, for the host.
             rec.scope("readback", |rec| {
                 rec.host_read(&self.work_counters)?;

@@ -180,7 +180,8 @@ mod tests {
     /// Each range check refuses, naming its flag.
     #[test]
     fn every_range_is_checked_once_here() {
-        let cases: Vec<(&str, Box<dyn Fn(&mut FrameDesc)>)> = vec![
+        type Edit = Box<dyn Fn(&mut FrameDesc)>;
+        let cases: Vec<(&str, Edit)> = vec![
             ("--epsilon", Box::new(|d| d.integration.epsilon = f32::NAN)),
             ("--epsilon", Box::new(|d| d.integration.epsilon = -1.0)),
             ("--epsilon", Box::new(|d| d.integration.epsilon = f32::INFINITY)),
@@ -192,7 +193,10 @@ mod tests {
             ("--fov", Box::new(|d| d.camera.fov_y_deg = 1e-37)),
             ("--light", Box::new(|d| d.lights.clear())),
             ("--light", Box::new(|d| d.lights = vec![d.lights[0]; crate::gpu::MAX_LIGHTS + 1])),
-            ("--light point", Box::new(|d| d.lights[0] = Light::Point { position: Vec3::X * 1e16, intensity: Vec3::ONE })),
+            (
+                "--light point",
+                Box::new(|d| d.lights[0] = Light::Point { position: Vec3::X * 1e16, intensity: Vec3::ONE }),
+            ),
             ("light intensity", Box::new(|d| d.lights[0] = Light::Point { position: Vec3::X, intensity: -Vec3::ONE })),
         ];
         for (needle, edit) in cases {

@@ -15,11 +15,11 @@ use crate::gpu::{
 };
 use crate::materials::Material;
 use crate::mesh::Mesh;
-use crate::physics::Diffusion;
 use crate::passes::sampling::prefix_bytes;
 use crate::passes::shadow;
 use crate::passes::sort::SortBuffers;
 use crate::passes::tree::TreeBuffers;
+use crate::physics::Diffusion;
 use crate::scene::Light;
 use crate::vk::{self, Buffer, BufferUsageFlags, Context, Extent2D, Image, ImageUsageFlags, MemoryLocation, Sampler};
 use crate::{bad_input, runtime};

@@ -1,4 +1,5 @@
-//! What is drawn: a mesh, a camera, lights, and the scene's scale in millimetres.
+//! Cameras and lights, and a scene of one mesh as the command line describes it (settings turn
+//! it into a `World` and a `FrameDesc`).
 
 use glam::{Mat4, Vec3};
 
@@ -128,18 +129,4 @@ pub struct Scene {
     pub lights: Vec<Light>,
     /// Millimetres per scene unit (materials are given per mm).
     pub mm_per_unit: f32,
-}
-
-impl Scene {
-    pub fn validate(&self) -> Result<()> {
-        self.mesh.validate()?;
-        self.camera.validate()?;
-        for light in &self.lights {
-            light.validate()?;
-        }
-        if !(self.mm_per_unit.is_finite() && self.mm_per_unit > 0.0) {
-            return Err(bad_input!("--scale {}: must be a positive number of millimetres per unit", self.mm_per_unit));
-        }
-        Ok(())
-    }
 }

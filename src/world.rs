@@ -87,10 +87,10 @@ impl World {
 
     /// The box around every object, in world coordinates.
     pub fn bounds(&self) -> (Vec3, Vec3) {
-        self.objects.iter().map(|o| o.world_mesh().bounds()).fold(
-            (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
-            |(lo, hi), (a, b)| (lo.min(a), hi.max(b)),
-        )
+        self.objects
+            .iter()
+            .map(|o| o.world_mesh().bounds())
+            .fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), (a, b)| (lo.min(a), hi.max(b)))
     }
 }
 

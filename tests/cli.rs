@@ -258,7 +258,10 @@ fn render_flags_default_to_the_library_settings() {
         (ai.epsilon, ai.brute_force, a.specular, a.roughness),
         (bi.epsilon, bi.brute_force, b.specular, b.roughness)
     );
-    assert_eq!((flags.desc.width, flags.desc.height, flags.world.objects[0].samples), (code.desc.width, code.desc.height, code.world.objects[0].samples));
+    assert_eq!(
+        (flags.desc.width, flags.desc.height, flags.world.objects[0].samples),
+        (code.desc.width, code.desc.height, code.world.objects[0].samples)
+    );
     assert_eq!(
         (flags.desc.shadow_resolution, flags.desc.show, flags.desc.exposure),
         (code.desc.shadow_resolution, code.desc.show, code.desc.exposure)

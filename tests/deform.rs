@@ -135,3 +135,39 @@ fn bad_deformations_are_bad_input() {
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("frame-{frame}.obj"), "{}", stderr(&out));
 }
+
+/// A `{frame}` sequence whose files differ in triangle count (UV spheres of 16×8, 256×128 and
+/// 512×256 segments): every frame equals its file rendered alone. The prefix sum of triangle
+/// areas was once re-allocated at a quarter of its size when the count changed, and every frame
+/// after the first came out almost black with no error.
+#[test]
+fn a_sequence_whose_topology_changes_renders_each_frame_as_its_file_alone() {
+    let dir = output_dir().join("topology");
+    std::fs::create_dir_all(&dir).unwrap();
+    for (i, rings) in [8, 128, 256].into_iter().enumerate() {
+        let mesh = Mesh::sphere(1.0, rings);
+        let mut obj = String::new();
+        for (p, n) in mesh.positions.iter().zip(&mesh.normals) {
+            obj += &format!("v {} {} {}\nvn {} {} {}\n", p.x, p.y, p.z, n.x, n.y, n.z);
+        }
+        for t in mesh.indices.chunks_exact(3) {
+            let [a, b, c] = [t[0] + 1, t[1] + 1, t[2] + 1];
+            obj += &format!("f {a}//{a} {b}//{b} {c}//{c}\n");
+        }
+        std::fs::write(dir.join(format!("s-{i:04}.obj")), obj).unwrap();
+    }
+    let pattern = dir.join("s-{frame}.obj");
+    let common = ["--eye", "0.6,0.6,3", "--target", "0,0,0", "--light-dir", "0.3,1,0.5"];
+    let mut args = vec!["--mesh", pattern.to_str().unwrap()];
+    args.extend_from_slice(&common);
+    let played = render_frames("topology", &args, 3);
+    for (i, path) in played.iter().enumerate() {
+        let file = dir.join(format!("s-{i:04}.obj"));
+        let mut single = vec!["--mesh", file.to_str().unwrap()];
+        single.extend_from_slice(&common);
+        let alone = render_frames(&format!("topology-alone-{i}"), &single, 1);
+        let (a, b) = (load(path), load(&alone[0]));
+        let mean = |img: &image::RgbaImage| img.pixels().map(|p| p[1] as f64).sum::<f64>() / img.pixels().len() as f64;
+        assert!(a == b, "frame {i}: mean green {:.1} in the sequence, {:.1} alone", mean(&a), mean(&b));
+    }
+}

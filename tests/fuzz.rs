@@ -287,7 +287,7 @@ fn check_argv(argv: &[String]) -> Result<(), TestCaseError> {
             if let Ok(material) = args.material.material() {
                 let spec = translucent::plot::ProfileSpec {
                     material,
-                    models: args.model.iter().map(|&m| m.into()).collect(),
+                    models: args.model.clone(),
                     angles_deg: args.angles.clone(),
                     r_min_mm: args.r_min,
                     r_max_mm: args.r_max.unwrap_or(100.0),

@@ -371,3 +371,33 @@ fn stratification_holds_over_two_million_triangles() {
     println!("{} triangles, {n} points: worst cumulative count off by {worst:.2} points", areas.len());
     assert!(worst <= 1.5, "the stratification drifts by {worst:.2} points");
 }
+
+/// The sampling pass checks the bytes its shaders will touch against the buffers bound (the
+/// validation layer's GPU-assisted mode, which would catch a shader writing past a buffer's end,
+/// does not run on lavapipe): a prefix sum sized as `Hierarchy::set_mesh` once re-allocated it,
+/// a quarter of what the triangles need, is refused by name before anything is submitted.
+#[test]
+fn sampling_refuses_buffers_smaller_than_its_counts_need() {
+    use translucent::passes::sampling::{prefix_bytes, SamplingPass};
+    use translucent::vk::{Buffer, MemoryLocation};
+    let (ctx, counts) = validated_context();
+    let mesh = Mesh::sphere(1.0, 16);
+    let storage = BufferUsageFlags::STORAGE_BUFFER;
+    let vertices = translucent::vk::upload_buffer(&ctx, "vertices", &mesh.vertex_data(), storage).unwrap();
+    let indices = translucent::vk::upload_buffer(&ctx, "indices", &mesh.indices, storage).unwrap();
+    let t = mesh.triangle_count() as u32;
+    let buffer = |name: &str, bytes: u64| Buffer::new(&ctx, name, bytes, storage, MemoryLocation::GpuOnly).unwrap();
+    let points = buffer("points", 1000 * 64);
+    let pass = SamplingPass::new(&ctx).unwrap();
+    let old_size = buffer("triangle area prefix sum", (t as u64 + 1) * 4);
+    let e = ctx.submit(None, |rec| pass.record(rec, &vertices, &indices, t, &old_size, &points, 1000, 1)).unwrap_err();
+    assert!(e.to_string().contains("triangle area prefix sum"), "{e}");
+    assert_eq!(prefix_bytes(t), 8 + (t as u64 + 1) * 8);
+    let right = buffer("triangle area prefix sum", prefix_bytes(t));
+    ctx.submit(None, |rec| pass.record(rec, &vertices, &indices, t, &right, &points, 1000, 1)).unwrap();
+    let e = ctx.submit(None, |rec| pass.record(rec, &vertices, &indices, t, &right, &points, 1001, 1)).unwrap_err();
+    assert!(e.to_string().contains("points"), "{e}");
+    drop((pass, old_size, right, points, vertices, indices));
+    drop(ctx);
+    assert_clean(&counts);
+}

@@ -532,7 +532,8 @@ fn tree_has_no_bias_against_brute_force() {
     for (name, scene, material) in [("skin1-sphere", &skin, &skin1), ("slab", &slab, &slab_material)] {
         for model in [Model::Directional, Model::Dipole] {
             let mut s = settings(scene);
-            (s.world.objects[0].material, s.desc.integration.model, s.desc.integration.brute_force) = (material.clone(), model, true);
+            (s.world.objects[0].material, s.desc.integration.model, s.desc.integration.brute_force) =
+                (material.clone(), model, true);
             let brute = render(&s);
             s.desc.integration.brute_force = false;
             let tree = render(&s);

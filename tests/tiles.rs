@@ -12,7 +12,9 @@ use translucent::scene::{bounding_sphere, Camera, Light};
 use translucent::world::World;
 
 /// A skin torus at 70x45 with 9000 points and ε = 0.1: the renderer, the world and the frame.
-fn torus_renderer(brute_force: bool) -> (Renderer, (World, FrameDesc), std::sync::Arc<translucent::vk::ValidationCounts>) {
+fn torus_renderer(
+    brute_force: bool,
+) -> (Renderer, (World, FrameDesc), std::sync::Arc<translucent::vk::ValidationCounts>) {
     let (ctx, counts) = common::validated_context();
     let mesh = Mesh::from_spec("torus").unwrap();
     let (centre, radius) = bounding_sphere(&mesh.positions);

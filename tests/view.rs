@@ -376,3 +376,88 @@ fn without_a_window_system_view_exits_2_suggesting_render() {
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.lines().any(|l| l.starts_with("error:") && l.contains("translucent render")), "{err}");
 }
+
+/// Real key presses while a preview is shading (xdotool on a plain Xvfb, as a user's hands):
+/// brute force on (a slow preview begins), then, while it shades, the model switched, ε halved
+/// and brute force off again. The viewer goes on (it once exited 1 with "the pipeline for model 0
+/// was not prepared") and its last image equals the same settings given before it started.
+#[test]
+fn keys_pressed_while_a_preview_shades_end_in_the_image_of_the_same_settings() {
+    if !have_xvfb() {
+        return;
+    }
+    let Some(xdotool) = ["/usr/bin/xdotool", "/usr/local/bin/xdotool"].into_iter().find(|p| Path::new(p).is_file())
+    else {
+        eprintln!("skipped: xdotool is not installed (scripts/setup-debian installs it)");
+        return;
+    };
+    let one_at_a_time = XVFB.lock().unwrap_or_else(|e| e.into_inner());
+    // A preview of brute force over 60k points takes about a second on lavapipe.
+    let scene = ["--mesh", "sphere", "--width", "256", "--height", "192", "--samples", "60000", "--exposure", "0"];
+    let mut xvfb = Command::new("Xvfb")
+        .args(["-displayfd", "1", "-screen", "0", "640x480x24", "-nolisten", "tcp"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .expect("start Xvfb");
+    let display = {
+        use std::io::BufRead;
+        let mut line = String::new();
+        std::io::BufReader::new(xvfb.stdout.take().unwrap()).read_line(&mut line).unwrap();
+        format!(":{}", line.trim())
+    };
+    let shot = png("keys-during-preview");
+    let _ = std::fs::remove_file(&shot);
+    // Bounded: a viewer that missed its `q` ends after three minutes, failing the test.
+    let viewer = Command::new("timeout")
+        .args(["180", env!("CARGO_BIN_EXE_translucent")])
+        .args(["view", "--validation", "--no-panel", "--screenshot", shot.to_str().unwrap()])
+        .args(scene)
+        .env("DISPLAY", &display)
+        .env("RUST_LOG", "translucent=debug")
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("start the viewer");
+    let xdo = |args: &[&str]| {
+        let mut cmd = Command::new("timeout");
+        cmd.arg("20").arg(xdotool).args(args).env("DISPLAY", &display);
+        let out = cmd.output().expect("run xdotool");
+        String::from_utf8_lossy(&out.stdout).trim().to_string()
+    };
+    let window = (0..600)
+        .find_map(|_| {
+            let id = xdo(&["search", "--name", "translucent"]);
+            if id.is_empty() {
+                std::thread::sleep(std::time::Duration::from_millis(100));
+                None
+            } else {
+                Some(id.lines().next().unwrap_or_default().to_string())
+            }
+        })
+        .expect("the viewer's window appears");
+    xdo(&["windowfocus", "--sync", &window]);
+    // The first frame (full, 256x192) first; then the keys.
+    std::thread::sleep(std::time::Duration::from_secs(4));
+    xdo(&["key", "b"]);
+    std::thread::sleep(std::time::Duration::from_millis(400));
+    xdo(&["key", "d"]);
+    xdo(&["key", "bracketleft"]);
+    xdo(&["key", "b"]);
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    xdo(&["key", "q"]);
+    let out = viewer.wait_with_output().expect("the viewer exits");
+    let _ = xvfb.kill();
+    let _ = xvfb.wait();
+    drop(one_at_a_time);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(0), "exit {:?}:\n{err}", out.status.code());
+    assert!(!err.contains("vulkan validation"), "validation messages:\n{err}");
+    assert!(err.contains("Preview frame begun"), "a preview was shading when the keys came:\n{err}");
+
+    let reference = png("keys-reference");
+    let mut args = scene.to_vec();
+    args.extend_from_slice(&["--no-panel", "--model", "dipole", "--epsilon", "0.1"]);
+    let lines = ["frames 1".to_string(), format!("screenshot {}", reference.display()), "quit".to_string()];
+    assert_ok("keys-reference", &view("keys-reference", &args, &lines.each_ref().map(|l| l.as_str())));
+    assert!(load(&shot) == load(&reference), "the last image differs from the same settings given at the start");
+}

@@ -2,14 +2,13 @@
 
 use crate::cli::BssrdfArgs;
 use crate::error::Result;
-use crate::physics::{Diffusion, Model};
+use crate::physics::Diffusion;
 use crate::vk::Context;
 use crate::{bad_input, runtime};
 
-
 pub(super) fn bssrdf(args: &BssrdfArgs) -> Result<i32> {
     use std::io::Write;
-    let (model, diffusion) = (Model::from(args.model), Diffusion::from(args.diffusion));
+    let (model, diffusion) = (args.model, Diffusion::from(args.diffusion));
     let gpu = if args.gpu {
         let ctx = Context::new(&args.device.options())?;
         let pass = crate::passes::bssrdf_eval::BssrdfEvalPass::new(&ctx)?;

@@ -27,7 +27,7 @@ pub(super) fn profile(args: &ProfileArgs) -> Result<i32> {
     };
     let spec = crate::plot::ProfileSpec {
         material,
-        models: args.model.iter().map(|&m| m.into()).collect(),
+        models: args.model.clone(),
         angles_deg: args.angles.clone(),
         r_min_mm: args.r_min,
         r_max_mm: r_max,

@@ -141,8 +141,8 @@ impl ShadePass {
     /// yet: each is a compilation on llvmpipe, so only what a frame uses is made.
     pub fn prepare(&mut self, ctx: &Context, model: Model, brute_force: bool) -> Result<()> {
         for additive in [false, true].into_iter().take(1 + brute_force as usize) {
-            if !self.shading.contains_key(&(model, additive)) {
-                self.shading.insert((model, additive), shading_pipeline(ctx, model, additive)?);
+            if let std::collections::hash_map::Entry::Vacant(slot) = self.shading.entry((model, additive)) {
+                slot.insert(shading_pipeline(ctx, model, additive)?);
             }
         }
         Ok(())
@@ -191,9 +191,10 @@ impl ShadePass {
         let mut c = *constants;
         c.point_range = glam::UVec4::new(unit.first_point, unit.point_count, 0, 0);
         let additive = unit.point_count > 0;
-        let pipeline = self.shading.get(&(model, additive)).ok_or_else(|| {
-            crate::runtime!("shade: the pipeline of the {} model was not prepared", model.name())
-        })?;
+        let pipeline = self
+            .shading
+            .get(&(model, additive))
+            .ok_or_else(|| crate::runtime!("shade: the pipeline of the {} model was not prepared", model.name()))?;
         // One rendering scope per unit: every draw writes the work counters, and the barrier
         // between two writes cannot sit inside a rendering scope.
         rec.prepare_draw_reads(&binds)?;

@@ -108,7 +108,10 @@ mod tests {
     fn state() -> ViewState {
         let world = World::single(Mesh::sphere(1.0, 8), Material::find("marble").unwrap(), 10.0);
         let camera = Camera { eye: Vec3::new(0.0, 0.0, 5.0), target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 40.0 };
-        ViewState::new(world, FrameDesc::new(camera, vec![Light::Directional { toward: Vec3::Y, irradiance: Vec3::ONE }]))
+        ViewState::new(
+            world,
+            FrameDesc::new(camera, vec![Light::Directional { toward: Vec3::Y, irradiance: Vec3::ONE }]),
+        )
     }
 
     #[test]
