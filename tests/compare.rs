@@ -120,8 +120,8 @@ fn a_mask_selects_the_pixels() {
     let mut a_img = b_img.clone();
     for (i, p) in a_img.pixels.iter_mut().enumerate() {
         if (i as u32) / W < H / 2 {
-            for c in 0..3 {
-                p[c] *= 2.0;
+            for v in p.iter_mut().take(3) {
+                *v *= 2.0;
             }
         }
     }
