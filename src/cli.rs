@@ -34,6 +34,62 @@ pub enum Command {
     Bench(BenchArgs),
     /// Show the scene in a window: orbit camera, light and material edits, scripted runs.
     View(Box<ViewArgs>),
+    /// Compare a linear EXR (A) with a reference (B): per channel the ratio of means, relative
+    /// RMSE and largest error over the pixels both cover, FLIP, an error image.
+    Compare(CompareArgs),
+    /// Write what `render` would draw as another renderer's scene (`export mitsuba`).
+    Export(ExportArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct CompareArgs {
+    /// The image to judge (linear EXR, alpha = coverage).
+    pub a: PathBuf,
+    /// The reference (linear EXR, alpha = coverage), e.g. a path tracer's.
+    pub b: PathBuf,
+    /// Compare only where this image (PNG or EXR, same size) is at least 0.5 (mean of R, G, B)
+    /// instead of where both are fully covered.
+    #[arg(long, value_name = "FILE")]
+    pub mask: Option<PathBuf>,
+    /// Write the error image: max over channels of |A − B| / mean B, false colour, scale drawn under it.
+    #[arg(long, value_name = "FILE.png")]
+    pub error_image: Option<PathBuf>,
+    /// Full scale of the error image, as a fraction of B's mean (default: B's 99th percentile, rounded up to 1, 2 or 5 × 10^k).
+    #[arg(long, allow_hyphen_values = true, value_parser = positive_f64_arg)]
+    pub error_scale: Option<f64>,
+    /// Exposure in stops of the tone mapping both go through for FLIP (default: B's automatic exposure).
+    #[arg(long, allow_hyphen_values = true, value_parser = finite_f32)]
+    pub exposure: Option<f32>,
+    /// Print the result as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Args, Debug)]
+pub struct ExportArgs {
+    #[command(subcommand)]
+    pub format: ExportFormat,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum ExportFormat {
+    /// A Mitsuba 3 scene (scene.xml, meshes as PLY) of exactly what `render` with these options would draw.
+    Mitsuba(Box<MitsubaArgs>),
+}
+
+#[derive(Args, Debug)]
+pub struct MitsubaArgs {
+    /// Angular radius of the disks that stand in for directional lights (a delta light behind a
+    /// smooth dielectric is black in Mitsuba's unidirectional integrators).
+    #[arg(long, allow_hyphen_values = true, default_value_t = 5.0, value_parser = finite_f32, value_name = "DEG")]
+    pub light_radius: f32,
+    /// Samples per pixel written as the scene's default (scripts/reference overrides it).
+    #[arg(long, allow_hyphen_values = true, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..))]
+    pub spp: u32,
+    /// The render options: what `render` takes; `--out DIR` is the folder the scene is written
+    /// into (created when missing).
+    #[command(flatten)]
+    pub render: RenderArgs,
 }
 
 #[derive(Args, Debug)]
@@ -354,6 +410,14 @@ pub(crate) fn finite_f32(s: &str) -> std::result::Result<f32, String> {
     Ok(v)
 }
 
+fn positive_f64_arg(s: &str) -> std::result::Result<f64, String> {
+    let v = any_f64(s)?;
+    if !(v.is_finite() && v > 0.0) {
+        return Err(format!("'{s}' must be a positive number"));
+    }
+    Ok(v)
+}
+
 fn positive_f32(s: &str) -> std::result::Result<f32, String> {
     let v = finite_f32(s)?;
     if v <= 0.0 {
@@ -397,7 +461,7 @@ pub fn usage_exit(e: clap::Error) -> i32 {
         },
         ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand | ErrorKind::MissingSubcommand => {
             crate::note!(
-                "error: a command is required: render, view, devices, materials, bssrdf, profile or bench\n\n{}",
+                "error: a command is required: render, view, devices, materials, bssrdf, profile, bench, compare or export\n\n{}",
                 e.render()
             );
             2

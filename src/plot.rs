@@ -162,7 +162,7 @@ fn write_csv(curves: &[Curve], path: &Path) -> Result<()> {
     crate::output::write_file(path, text.as_bytes()).map_err(|e| runtime!("--out: {e}"))
 }
 
-fn register_font() -> Result<()> {
+pub(crate) fn register_font() -> Result<()> {
     static FONT: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
     plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
         .map_err(|_| runtime!("the embedded font could not be read"))

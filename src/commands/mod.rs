@@ -3,7 +3,9 @@
 //! kind it is (src/error.rs).
 
 mod bssrdf;
+mod compare;
 mod devices;
+mod export;
 mod profile;
 mod render;
 
@@ -27,6 +29,10 @@ pub fn run(cli: Cli) -> Result<i32> {
         Command::Profile(args) => profile::profile(&args),
         Command::View(args) => crate::view::run(&args),
         Command::Bench(args) => bench(&args),
+        Command::Compare(args) => compare::compare(&args),
+        Command::Export(args) => match args.format {
+            crate::cli::ExportFormat::Mitsuba(m) => export::mitsuba(&m),
+        },
     }
 }
 

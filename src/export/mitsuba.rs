@@ -1,0 +1,471 @@
+//! A Mitsuba 3 scene (XML, meshes as binary PLY) of a camera, lights and objects, in millimetres.
+//!
+//! Everything here takes plain values — a camera, lights, objects each with its mesh, its surface
+//! and its millimetres per unit — so that any scene description can be exported through it.
+//!
+//! What is written, and why:
+//! - A translucent object is a shape with a smooth `dielectric` boundary (int_ior = η, ext_ior = 1)
+//!   around a `homogeneous` medium: `sigma_t` = σa + σs per mm (Mitsuba wants RGB values in [0, 1],
+//!   so it is written normalised, with its largest channel as `scale`), `albedo` = σs / σt, and an
+//!   `hg` phase function with g (`isotropic` for g = 0). Mitsuba's `hg` has one g for all channels:
+//!   a material whose g differs between channels is written with the similarity-reduced σ's =
+//!   σs(1 − g) and g = 0 — what both diffusion models see — and a warning says so.
+//! - An opaque object is `diffuse` with its reflectance.
+//! - A directional light (irradiance E at normal incidence) becomes a far disk of angular radius δ
+//!   emitting radiance E / (π sin²δ), which gives irradiance E at normal incidence: a delta
+//!   `directional` emitter behind a smooth dielectric renders exactly black in Mitsuba's
+//!   unidirectional integrators (no path from inside the medium can connect to it). δ = 5° by
+//!   default. The disk lies beyond the camera's far clip, so the camera never sees it directly
+//!   (translucent does not draw lights either).
+//! - A point light of intensity I (per scene unit², E = I / d²) becomes a `point` emitter with
+//!   intensity I × (mm per unit)².
+//! - The camera is a `perspective` sensor with the vertical field of view (`fov_axis` y, aspect
+//!   width / height as the renderer's projection), a box reconstruction filter (a pixel is the mean
+//!   over its area) and an RGBA film: alpha is coverage, as in translucent's EXR output.
+//! - The integrator is `volpathmis` (spectral MIS: far less noisy than `volpath` when σt differs
+//!   between channels) with unbounded depth (`max_depth` −1, Russian roulette from `rr_depth`).
+//! - `$spp`, `$seed`, `$max_depth`, `$rr_depth` and `$transmittance` are scene parameters:
+//!   rendering with `transmittance` = 0 (the boundary's `specular_transmittance`) gives the
+//!   boundary's reflection alone, and the full render minus that is the light that went through the
+//!   medium — the subsurface term, what `render --no-specular` draws.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use glam::{DVec3, Vec3};
+
+use crate::error::Result;
+use crate::mesh::Mesh;
+use crate::{bad_input, runtime};
+
+/// A pinhole camera in millimetres; `fov_y_deg` is the vertical field of view.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    pub eye: DVec3,
+    pub target: DVec3,
+    pub up: DVec3,
+    pub fov_y_deg: f64,
+}
+
+/// Lights in millimetres: directions toward the light; irradiance in the renderer's units.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Light {
+    /// Irradiance E per channel on a surface facing the light.
+    Directional { toward: DVec3, irradiance: [f64; 3] },
+    /// Radiant intensity per channel such that E = intensity / d², d in mm.
+    Point { position: DVec3, intensity: [f64; 3] },
+}
+
+/// A homogeneous medium, coefficients per mm.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Medium {
+    pub sigma_a: [f64; 3],
+    pub sigma_s: [f64; 3],
+    pub g: [f64; 3],
+    pub eta: f64,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Surface {
+    /// A smooth dielectric boundary of the medium's η around the medium.
+    Translucent(Medium),
+    /// An opaque Lambertian surface.
+    Diffuse { reflectance: [f64; 3] },
+}
+
+/// One object: its mesh in its own units, how many mm a unit is, and its surface.
+#[derive(Clone, Debug)]
+pub struct Object<'a> {
+    pub name: String,
+    pub mesh: &'a Mesh,
+    pub mm_per_unit: f64,
+    pub surface: Surface,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Options {
+    pub width: u32,
+    pub height: u32,
+    /// Default samples per pixel (`$spp`).
+    pub spp: u32,
+    /// Angular radius of the disks that stand in for directional lights, degrees.
+    pub light_radius_deg: f64,
+    /// Default `$max_depth` (−1: unbounded).
+    pub max_depth: i32,
+    /// Default `$rr_depth` (`None`: [`auto_rr_depth`] of the media).
+    pub rr_depth: Option<u32>,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options { width: 512, height: 512, spp: 256, light_radius_deg: 5.0, max_depth: -1, rr_depth: None }
+    }
+}
+
+/// What Mitsuba's `homogeneous` medium is given: σt normalised to [0, 1] with its largest channel
+/// as the scale, the albedo, and one HG g (`None`: isotropic).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Homogeneous {
+    pub sigma_t: [f64; 3],
+    pub scale: f64,
+    pub albedo: [f64; 3],
+    pub g: Option<f64>,
+    /// Set when g differed between channels and the reduced σ's with g = 0 was written instead.
+    pub warning: Option<String>,
+}
+
+/// The medium as Mitsuba takes it.
+pub fn homogeneous(m: &Medium) -> Homogeneous {
+    let same_g = m.g.iter().all(|&g| g == m.g[0]);
+    let (sigma_s, g, warning) = if same_g {
+        (m.sigma_s, m.g[0], None)
+    } else {
+        (
+            std::array::from_fn(|c| m.sigma_s[c] * (1.0 - m.g[c])),
+            0.0,
+            Some(format!(
+                "g = {:?} differs between channels and Mitsuba's hg has one g: the medium is written with σ's = σs(1 − g) = {:?} /mm and g = 0 (what both diffusion models see)",
+                m.g,
+                std::array::from_fn::<f64, 3, _>(|c| m.sigma_s[c] * (1.0 - m.g[c]))
+            )),
+        )
+    };
+    let sigma_t: [f64; 3] = std::array::from_fn(|c| m.sigma_a[c] + sigma_s[c]);
+    let scale = sigma_t.iter().copied().fold(0.0, f64::max);
+    Homogeneous {
+        sigma_t: sigma_t.map(|v| if scale > 0.0 { v / scale } else { 0.0 }),
+        scale,
+        albedo: std::array::from_fn(|c| if sigma_t[c] > 0.0 { sigma_s[c] / sigma_t[c] } else { 0.0 }),
+        g: (g != 0.0).then_some(g),
+        warning,
+    }
+}
+
+/// The depth from which Russian roulette starts: Mitsuba's survival probability is
+/// min(throughput, 0.95), which for a high albedo α would kill 5% of the paths per bounce while
+/// the throughput α^n is still above 0.95; from n = ln 0.95 / ln α on it is ordinary roulette. So:
+/// that n for the highest albedo, plus 5, within [5, 1000].
+pub fn auto_rr_depth(media: &[Homogeneous]) -> u32 {
+    let albedo = media.iter().flat_map(|h| h.albedo).fold(0.0, f64::max);
+    if albedo >= 1.0 {
+        return 1000;
+    }
+    let n = if albedo > 0.0 { (0.95f64.ln() / albedo.ln()).ceil() } else { 0.0 };
+    (n + 5.0).clamp(5.0, 1000.0) as u32
+}
+
+/// The radiance of a disk of angular radius `radius_deg` that gives irradiance `e` at normal
+/// incidence: E = π L sin²δ.
+pub fn disk_radiance(e: f64, radius_deg: f64) -> f64 {
+    e / (std::f64::consts::PI * radius_deg.to_radians().sin().powi(2))
+}
+
+/// Numbers as Mitsuba reads them: shortest round trip, exponent where long.
+fn num(v: f64) -> String {
+    format!("{v:?}")
+}
+
+fn triple(v: [f64; 3]) -> String {
+    format!("{}, {}, {}", num(v[0]), num(v[1]), num(v[2]))
+}
+
+fn dv(v: DVec3) -> [f64; 3] {
+    [v.x, v.y, v.z]
+}
+
+/// An up vector for `lookat` along `dir`: the world axis least aligned with it.
+fn any_up(dir: DVec3) -> DVec3 {
+    let a = dir.abs();
+    if a.x <= a.y && a.x <= a.z {
+        DVec3::X
+    } else if a.y <= a.z {
+        DVec3::Y
+    } else {
+        DVec3::Z
+    }
+}
+
+/// The files written.
+#[derive(Clone, Debug, Default)]
+pub struct Written {
+    pub scene: PathBuf,
+    pub meshes: Vec<PathBuf>,
+    pub warnings: Vec<String>,
+}
+
+/// Writes `scene.xml` and one PLY per object (in mm) into `dir`, which must exist.
+pub fn write_scene(
+    dir: &Path,
+    camera: &Camera,
+    lights: &[Light],
+    objects: &[Object],
+    options: &Options,
+) -> Result<Written> {
+    if objects.is_empty() {
+        return Err(bad_input!("export: nothing to export (no objects)"));
+    }
+    if !(options.light_radius_deg > 0.0 && options.light_radius_deg < 90.0) {
+        return Err(bad_input!("--light-radius {}: must be within (0, 90) degrees", options.light_radius_deg));
+    }
+    let mut written = Written::default();
+    // The objects' bounds in mm: where the disks and the clip planes go.
+    let (mut lo, mut hi) = (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN));
+    for o in objects {
+        for p in &o.mesh.positions {
+            let p = p.as_dvec3() * o.mm_per_unit;
+            lo = lo.min(p);
+            hi = hi.max(p);
+        }
+    }
+    let centre = (lo + hi) * 0.5;
+    let radius = ((hi - lo).length() * 0.5).max(1e-30);
+    let distance = (camera.eye - centre).length();
+    let far_clip = 2.0 * (distance + radius);
+    let near_clip = ((distance - 1.5 * radius) * 0.5).max(far_clip * 1e-6);
+    let disk_distance = 1000.0 * (distance + radius);
+
+    let media: Vec<Homogeneous> = objects
+        .iter()
+        .filter_map(|o| match &o.surface {
+            Surface::Translucent(m) => Some(homogeneous(m)),
+            Surface::Diffuse { .. } => None,
+        })
+        .collect();
+    let rr_depth = options.rr_depth.unwrap_or_else(|| auto_rr_depth(&media));
+    let mut x = String::new();
+    let w = &mut x;
+    let _ = writeln!(w, "<?xml version=\"1.0\" encoding=\"utf-8\"?>");
+    let _ = writeln!(
+        w,
+        "<!-- Written by translucent {} (export mitsuba). Lengths in mm. Directional lights are far disks of angular radius {}° (a delta light behind a smooth dielectric is black in unidirectional integrators). Render with transmittance=0 for the boundary's reflection alone; the full render minus it is the subsurface term. -->",
+        env!("CARGO_PKG_VERSION"),
+        num(options.light_radius_deg)
+    );
+    let _ = writeln!(w, "<scene version=\"3.0.0\">");
+    for (name, value) in [
+        ("spp", options.spp.to_string()),
+        ("seed", "0".to_string()),
+        ("max_depth", options.max_depth.to_string()),
+        ("rr_depth", rr_depth.to_string()),
+        ("transmittance", "1".to_string()),
+    ] {
+        let _ = writeln!(w, "    <default name=\"{name}\" value=\"{value}\"/>");
+    }
+    let _ = writeln!(w, "    <integrator type=\"volpathmis\">");
+    let _ = writeln!(w, "        <integer name=\"max_depth\" value=\"$max_depth\"/>");
+    let _ = writeln!(w, "        <integer name=\"rr_depth\" value=\"$rr_depth\"/>");
+    let _ = writeln!(w, "    </integrator>");
+    let _ = writeln!(w, "    <sensor type=\"perspective\">");
+    let _ = writeln!(w, "        <string name=\"fov_axis\" value=\"y\"/>");
+    let _ = writeln!(w, "        <float name=\"fov\" value=\"{}\"/>", num(camera.fov_y_deg));
+    let _ = writeln!(w, "        <float name=\"near_clip\" value=\"{}\"/>", num(near_clip));
+    let _ = writeln!(w, "        <float name=\"far_clip\" value=\"{}\"/>", num(far_clip));
+    let _ = writeln!(w, "        <transform name=\"to_world\">");
+    let _ = writeln!(
+        w,
+        "            <lookat origin=\"{}\" target=\"{}\" up=\"{}\"/>",
+        triple(dv(camera.eye)),
+        triple(dv(camera.target)),
+        triple(dv(camera.up))
+    );
+    let _ = writeln!(w, "        </transform>");
+    let _ = writeln!(w, "        <sampler type=\"independent\">");
+    let _ = writeln!(w, "            <integer name=\"sample_count\" value=\"$spp\"/>");
+    let _ = writeln!(w, "            <integer name=\"seed\" value=\"$seed\"/>");
+    let _ = writeln!(w, "        </sampler>");
+    let _ = writeln!(w, "        <film type=\"hdrfilm\">");
+    let _ = writeln!(w, "            <integer name=\"width\" value=\"{}\"/>", options.width);
+    let _ = writeln!(w, "            <integer name=\"height\" value=\"{}\"/>", options.height);
+    let _ = writeln!(w, "            <string name=\"pixel_format\" value=\"rgba\"/>");
+    let _ = writeln!(w, "            <rfilter type=\"box\"/>");
+    let _ = writeln!(w, "        </film>");
+    let _ = writeln!(w, "    </sensor>");
+
+    for (i, o) in objects.iter().enumerate() {
+        let ply = format!("object{i}.ply");
+        let path = dir.join(&ply);
+        write_ply(&path, o.mesh, o.mm_per_unit)?;
+        written.meshes.push(path);
+        let _ = writeln!(w, "    <!-- {} -->", xml_comment(&o.name));
+        match &o.surface {
+            Surface::Translucent(m) => {
+                let h = homogeneous(m);
+                if let Some(warning) = &h.warning {
+                    written.warnings.push(format!("{}: {warning}", o.name));
+                }
+                let _ = writeln!(w, "    <medium type=\"homogeneous\" id=\"medium{i}\">");
+                let _ = writeln!(w, "        <rgb name=\"sigma_t\" value=\"{}\"/>", triple(h.sigma_t));
+                let _ = writeln!(w, "        <float name=\"scale\" value=\"{}\"/>", num(h.scale));
+                let _ = writeln!(w, "        <rgb name=\"albedo\" value=\"{}\"/>", triple(h.albedo));
+                match h.g {
+                    Some(g) => {
+                        let _ =
+                            writeln!(w, "        <phase type=\"hg\"><float name=\"g\" value=\"{}\"/></phase>", num(g));
+                    }
+                    None => {
+                        let _ = writeln!(w, "        <phase type=\"isotropic\"/>");
+                    }
+                }
+                let _ = writeln!(w, "    </medium>");
+                let _ = writeln!(w, "    <bsdf type=\"dielectric\" id=\"bsdf{i}\">");
+                let _ = writeln!(w, "        <float name=\"int_ior\" value=\"{}\"/>", num(m.eta));
+                let _ = writeln!(w, "        <float name=\"ext_ior\" value=\"1.0\"/>");
+                let _ = writeln!(w, "        <float name=\"specular_transmittance\" value=\"$transmittance\"/>");
+                let _ = writeln!(w, "    </bsdf>");
+                let _ = writeln!(w, "    <shape type=\"ply\" id=\"object{i}\">");
+                let _ = writeln!(w, "        <string name=\"filename\" value=\"{ply}\"/>");
+                let _ = writeln!(w, "        <ref id=\"bsdf{i}\"/>");
+                let _ = writeln!(w, "        <ref name=\"interior\" id=\"medium{i}\"/>");
+                let _ = writeln!(w, "    </shape>");
+            }
+            Surface::Diffuse { reflectance } => {
+                let _ = writeln!(w, "    <shape type=\"ply\" id=\"object{i}\">");
+                let _ = writeln!(w, "        <string name=\"filename\" value=\"{ply}\"/>");
+                let _ = writeln!(
+                    w,
+                    "        <bsdf type=\"diffuse\"><rgb name=\"reflectance\" value=\"{}\"/></bsdf>",
+                    triple(*reflectance)
+                );
+                let _ = writeln!(w, "    </shape>");
+            }
+        }
+    }
+
+    for (i, light) in lights.iter().enumerate() {
+        match *light {
+            Light::Directional { toward, irradiance } => {
+                let toward = toward.normalize();
+                let origin = centre + toward * disk_distance;
+                let disk_radius = disk_distance * options.light_radius_deg.to_radians().tan();
+                let radiance = irradiance.map(|e| disk_radiance(e, options.light_radius_deg));
+                let _ = writeln!(
+                    w,
+                    "    <!-- light {i}: directional, irradiance {} at normal incidence: a disk of angular radius {}° at {} mm -->",
+                    triple(irradiance),
+                    num(options.light_radius_deg),
+                    num(disk_distance)
+                );
+                let _ = writeln!(w, "    <shape type=\"disk\" id=\"light{i}\">");
+                let _ = writeln!(w, "        <transform name=\"to_world\">");
+                let _ = writeln!(w, "            <scale value=\"{}\"/>", num(disk_radius));
+                let _ = writeln!(
+                    w,
+                    "            <lookat origin=\"{}\" target=\"{}\" up=\"{}\"/>",
+                    triple(dv(origin)),
+                    triple(dv(centre)),
+                    triple(dv(any_up(toward)))
+                );
+                let _ = writeln!(w, "        </transform>");
+                let _ = writeln!(
+                    w,
+                    "        <emitter type=\"area\"><rgb name=\"radiance\" value=\"{}\"/></emitter>",
+                    triple(radiance)
+                );
+                let _ = writeln!(w, "    </shape>");
+            }
+            Light::Point { position, intensity } => {
+                let _ = writeln!(w, "    <!-- light {i}: point -->");
+                let _ = writeln!(w, "    <emitter type=\"point\" id=\"light{i}\">");
+                let _ = writeln!(
+                    w,
+                    "        <point name=\"position\" x=\"{}\" y=\"{}\" z=\"{}\"/>",
+                    num(position.x),
+                    num(position.y),
+                    num(position.z)
+                );
+                let _ = writeln!(w, "        <rgb name=\"intensity\" value=\"{}\"/>", triple(intensity));
+                let _ = writeln!(w, "    </emitter>");
+            }
+        }
+    }
+    let _ = writeln!(w, "</scene>");
+    if x.contains("NaN") || x.contains("inf") {
+        return Err(runtime!("export: a non-finite number would be written to the scene"));
+    }
+    let scene = dir.join("scene.xml");
+    crate::output::write_file(&scene, x.as_bytes())?;
+    written.scene = scene;
+    Ok(written)
+}
+
+fn xml_comment(s: &str) -> String {
+    s.replace("--", "- -")
+}
+
+/// A binary little-endian PLY of the mesh scaled to mm: float x y z nx ny nz, int triangles.
+pub fn write_ply(path: &Path, mesh: &Mesh, mm_per_unit: f64) -> Result<()> {
+    let mut bytes = format!(
+        "ply\nformat binary_little_endian 1.0\ncomment translucent export mitsuba: millimetres\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nelement face {}\nproperty list uchar int vertex_indices\nend_header\n",
+        mesh.positions.len(),
+        mesh.indices.len() / 3
+    )
+    .into_bytes();
+    for (i, p) in mesh.positions.iter().enumerate() {
+        let q = (p.as_dvec3() * mm_per_unit).as_vec3();
+        let n = mesh.normals.get(i).copied().unwrap_or(Vec3::Y);
+        for v in [q.x, q.y, q.z, n.x, n.y, n.z] {
+            if !v.is_finite() {
+                return Err(runtime!("{}: vertex {i} is not finite in mm", path.display()));
+            }
+            bytes.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    for t in mesh.indices.chunks_exact(3) {
+        bytes.push(3);
+        for &i in t {
+            bytes.extend_from_slice(&(i as i32).to_le_bytes());
+        }
+    }
+    crate::output::write_file(path, &bytes)
+}
+
+/// Reads back a PLY as [`write_ply`] writes it: positions, normals, triangle indices (for tests
+/// and checks of exported scenes).
+pub fn read_ply(path: &Path) -> Result<Mesh> {
+    let bytes = std::fs::read(path).map_err(|e| bad_input!("{}: cannot be read: {e}", path.display()))?;
+    let end = b"end_header\n";
+    let header_len = bytes
+        .windows(end.len())
+        .position(|w| w == end)
+        .ok_or_else(|| bad_input!("{}: no PLY header", path.display()))?
+        + end.len();
+    let header =
+        std::str::from_utf8(&bytes[..header_len]).map_err(|_| bad_input!("{}: header is not text", path.display()))?;
+    if !header.contains("format binary_little_endian 1.0") {
+        return Err(bad_input!("{}: not a binary little-endian PLY", path.display()));
+    }
+    let count = |element: &str| -> Result<usize> {
+        header
+            .lines()
+            .find_map(|l| l.strip_prefix(&format!("element {element} ")))
+            .and_then(|n| n.trim().parse().ok())
+            .ok_or_else(|| bad_input!("{}: no element {element}", path.display()))
+    };
+    let (nv, nf) = (count("vertex")?, count("face")?);
+    let body = &bytes[header_len..];
+    if body.len() != nv * 24 + nf * 13 {
+        return Err(bad_input!(
+            "{}: {} bytes of data for {nv} vertices and {nf} triangles",
+            path.display(),
+            body.len()
+        ));
+    }
+    let f = |o: usize| f32::from_le_bytes([body[o], body[o + 1], body[o + 2], body[o + 3]]);
+    let mut mesh = Mesh { positions: Vec::with_capacity(nv), normals: Vec::with_capacity(nv), indices: Vec::new() };
+    for v in 0..nv {
+        let o = v * 24;
+        mesh.positions.push(Vec3::new(f(o), f(o + 4), f(o + 8)));
+        mesh.normals.push(Vec3::new(f(o + 12), f(o + 16), f(o + 20)));
+    }
+    for t in 0..nf {
+        let o = nv * 24 + t * 13;
+        if body[o] != 3 {
+            return Err(bad_input!("{}: face {t} is not a triangle", path.display()));
+        }
+        for k in 0..3 {
+            let p = o + 1 + 4 * k;
+            mesh.indices.push(i32::from_le_bytes([body[p], body[p + 1], body[p + 2], body[p + 3]]) as u32);
+        }
+    }
+    Ok(mesh)
+}
