@@ -179,9 +179,10 @@ pub struct DeviceArgs {
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
-    /// Mesh: `sphere`, `box`, `slab`, `torus`, or the path of an OBJ file (default: the Stanford
-    /// bunny from glmark2-data when installed, else the sphere). A `{frame}` in the path plays a
-    /// sequence of files, one per frame (numbered from 0 or 1, plain or padded to 4 digits).
+    /// Mesh: `sphere`, `box`, `slab`, `torus`, or the path of a mesh file: `.obj`, `.ply`, `.off`,
+    /// any of them gzip-compressed (`.ply.gz`) (default: the Stanford bunny from glmark2-data when
+    /// installed, else the sphere). A `{frame}` in the path plays a sequence of files, one per
+    /// frame (numbered from 0 or 1, plain or padded to 4 digits).
     #[arg(long)]
     pub mesh: Option<String>,
     /// Output image; the extension picks the format (.png or .exr). A `{frame}` in the name
