@@ -177,8 +177,12 @@ pub struct DeviceArgs {
     pub validation: bool,
 }
 
-#[derive(Args, Debug)]
+#[derive(Args, Debug, Clone)]
 pub struct RenderArgs {
+    /// A pbrt-v4 scene file (`scene.pbrt`): its camera, film, shape, material and lights; flags
+    /// typed here override them (see README, "Scenes").
+    #[arg(value_name = "SCENE.pbrt")]
+    pub scene: Option<PathBuf>,
     /// Mesh: `sphere`, `box`, `slab`, `torus`, or the path of a mesh file: `.obj`, `.ply`, `.off`,
     /// any of them gzip-compressed (`.ply.gz`) (default: the Stanford bunny from glmark2-data when
     /// installed, else the sphere). A `{frame}` in the path plays a sequence of files, one per

@@ -16,6 +16,7 @@ pub mod materials;
 pub mod mesh;
 pub mod output;
 pub mod passes;
+pub mod pbrt;
 pub mod physics;
 pub mod plot;
 pub mod profiling;

@@ -11,11 +11,19 @@ use super::{check_output_path, frame_path, validation_exit_code};
 
 pub(super) fn render(args: &RenderArgs) -> Result<i32> {
     // Check everything the user typed before the (slow) device start.
+    if let Some(scene) = &args.scene {
+        let argv: Vec<String> = std::env::args().collect();
+        let (args, settings) = crate::pbrt::render_settings(scene, args, &|f| crate::pbrt::flag_given(&argv, f))?;
+        return render_settings(&args, settings);
+    }
+    render_settings(args, RenderSettings::from_args(args)?)
+}
+
+fn render_settings(args: &RenderArgs, settings: RenderSettings) -> Result<i32> {
     check_output_path(&args.out, "--out", &["png", "exr"])?;
     if let Some(p) = &args.profile_out {
         check_output_path(p, "--profile-out", &["json"])?;
     }
-    let settings = RenderSettings::from_args(args)?;
     let material = &settings.subsurface.material;
     // The GPU shades in f32 (see `bssrdf --gpu`).
     if let Some(ch) = (0..3).find(|&c| material.sigma_a[c] + material.sigma_s[c] > crate::bssrdf_csv::GPU_MAX_SIGMA_T) {
