@@ -166,6 +166,117 @@ fn ply_text() -> impl Strategy<Value = Vec<u8>> {
         })
 }
 
+/// pbrt-v4 scene text: directives (known and not), parameter lists with declared types and
+/// values of every kind, brackets, strings with escapes, comments; valid and hostile.
+fn pbrt_text() -> impl Strategy<Value = Vec<u8>> {
+    let directive = prop::sample::select(vec![
+        "LookAt",
+        "Camera",
+        "Film",
+        "Scale",
+        "Translate",
+        "Rotate",
+        "Transform",
+        "ConcatTransform",
+        "Identity",
+        "CoordinateSystem",
+        "CoordSysTransform",
+        "ReverseOrientation",
+        "AttributeBegin",
+        "AttributeEnd",
+        "WorldBegin",
+        "MakeNamedMaterial",
+        "NamedMaterial",
+        "Material",
+        "Texture",
+        "Shape",
+        "LightSource",
+        "Sampler",
+        "Option",
+        "Include",
+        "ObjectBegin",
+        "Frobnicate",
+        "TransformBegin",
+        "TransformEnd",
+    ]);
+    let word = prop::sample::select(vec![
+        "\"perspective\"",
+        "\"subsurface\"",
+        "\"diffuse\"",
+        "\"sphere\"",
+        "\"trianglemesh\"",
+        "\"distant\"",
+        "\"point\"",
+        "\"spot\"",
+        "\"infinite\"",
+        "\"checkerboard\"",
+        "\"spectrum\"",
+        "\"rgb\"",
+        "\"camera\"",
+        "\"a\\\"b\"",
+        "\"x.pbrt\"",
+        "\"\"",
+        "[",
+        "]",
+        "true",
+        "#c\n",
+        "\"Skin1\"",
+    ]);
+    let decl = (
+        prop::sample::select(vec![
+            "float",
+            "integer",
+            "rgb",
+            "spectrum",
+            "point3",
+            "normal",
+            "point2",
+            "string",
+            "texture",
+            "bool",
+            "blackbody",
+            "quaternion",
+        ]),
+        prop::sample::select(vec![
+            "fov",
+            "P",
+            "indices",
+            "N",
+            "uv",
+            "radius",
+            "name",
+            "sigma_a",
+            "sigma_s",
+            "reflectance",
+            "mfp",
+            "L",
+            "from",
+            "to",
+            "scale",
+            "xresolution",
+            "type",
+            "filename",
+            "tex1",
+        ]),
+    )
+        .prop_map(|(t, n)| format!("\"{t} {n}\""));
+    let value = prop_oneof![
+        number(),
+        (-3i64..12).prop_map(|i| i.to_string()),
+        prop::collection::vec((-3i64..12).prop_map(|i| i.to_string()), 0..10)
+            .prop_map(|v| format!("[ {} ]", v.join(" "))),
+        word.clone().prop_map(str::to_string),
+    ];
+    let item = prop_oneof![
+        3 => directive.prop_map(str::to_string),
+        2 => word.prop_map(str::to_string),
+        3 => (decl, value.clone()).prop_map(|(d, v)| format!("{d} {v}")),
+        2 => value,
+        1 => "[ -~]{0,12}",
+    ];
+    prop::collection::vec(item, 0..40).prop_map(|v| v.join(" ").into_bytes())
+}
+
 /// OFF text: keyword, counts and records, valid and hostile, with comments and blank lines.
 fn off_text() -> impl Strategy<Value = Vec<u8>> {
     let keyword = prop::sample::select(vec!["OFF", "NOFF", "COFF", "STOFF", "CNOFF", "4OFF", "nOFF", "off", ""]);
@@ -379,6 +490,41 @@ fn check_round_trip(positions: &[[f32; 3]], faces: &[Vec<u32>], encoding: usize)
     Ok(())
 }
 
+/// A scene file either loads (every object's vertices finite, indices in range) or is refused as
+/// bad input whose message begins with the file's path (FILE:LINE:COLUMN).
+fn check_pbrt(bytes: &[u8]) -> Result<(), TestCaseError> {
+    thread_local!(static DIR: std::path::PathBuf = {
+        let d = std::env::temp_dir().join(format!("translucent-fuzz-pbrt-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    });
+    let path = DIR.with(|d| d.join(format!("fuzz-{:?}.pbrt", std::thread::current().id())));
+    std::fs::write(&path, bytes).unwrap();
+    match translucent::pbrt::load(&path) {
+        Ok(scene) => {
+            for o in &scene.objects {
+                prop_assert!(o.mesh.positions.iter().all(|p| p.is_finite()));
+                prop_assert!(o.mesh.indices.iter().all(|&i| (i as usize) < o.mesh.positions.len()));
+            }
+        }
+        Err(e) => {
+            prop_assert_eq!(e.exit_code(), 2, "{}", e);
+            prop_assert!(
+                e.to_string().starts_with(&*path.parent().unwrap().to_string_lossy()),
+                "error does not name the file: {}",
+                e
+            );
+        }
+    }
+    // The tokenizer alone, on the same text as a string: never a panic, errors located.
+    if let Ok(text) = std::str::from_utf8(bytes) {
+        if let Err(e) = translucent::pbrt::tokenizer::tokenize(text, "t") {
+            prop_assert!(e.starts_with("t:"), "{}", e);
+        }
+    }
+    Ok(())
+}
+
 fn check_csv(bytes: &[u8]) -> Result<(), TestCaseError> {
     let mut reader = Reader::new(bytes);
     loop {
@@ -563,6 +709,12 @@ fn ply_and_off_reader_properties() {
 }
 
 #[test]
+fn pbrt_reader_properties() {
+    run_cases(&pbrt_text(), CI_CASES, 12, |b| check_pbrt(&b));
+    run_cases(&prop::collection::vec(any::<u8>(), 0..400), 500, 13, |b| check_pbrt(&b));
+}
+
+#[test]
 fn csv_reader_properties() {
     run_cases(&csv_text(), CI_CASES, 3, |b| check_csv(&b));
     run_cases(&prop::collection::vec(any::<u8>(), 0..400), CI_CASES, 4, |b| check_csv(&b));
@@ -587,6 +739,13 @@ fn fuzz_ply_and_off_readers() {
     fuzz_for("PLY reader (bytes)", prop::collection::vec(any::<u8>(), 0..2000), |b| check_mesh(&b, MeshFormat::Ply));
     fuzz_for("OFF reader (grammar)", off_text(), |b| check_mesh(&b, MeshFormat::Off));
     fuzz_for("mesh round trip", (polygon_mesh(), 0usize..4), |((p, f), e)| check_round_trip(&p, &f, e));
+}
+
+#[test]
+#[ignore]
+fn fuzz_pbrt_reader() {
+    fuzz_for("pbrt-v4 reader (grammar)", pbrt_text(), |b| check_pbrt(&b));
+    fuzz_for("pbrt-v4 reader (bytes)", prop::collection::vec(any::<u8>(), 0..2000), |b| check_pbrt(&b));
 }
 
 #[test]

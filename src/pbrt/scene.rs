@@ -642,7 +642,15 @@ fn subsurface(p: &ParamList, loc: &Loc) -> Result<Subsurface, String> {
     };
     let (sigma_a, sigma_s, source) = if let Some(name) = p.string("name")? {
         let (a, s) = pbrt_medium(&name).ok_or_else(|| {
-            err(loc, format!("subsurface: no measured medium named \"{}\" in pbrt-v4's table (`translucent materials --pbrt` lists them)", short(&name)))
+            let names: Vec<&str> = super::PBRT_MEDIA.iter().map(|m| m.0).collect();
+            err(
+                loc,
+                format!(
+                    "subsurface: no measured medium named \"{}\" in pbrt-v4's table (its names: {})",
+                    short(&name),
+                    names.join(", ")
+                ),
+            )
         })?;
         // pbrt: the table gives reduced scattering coefficients, so g is 0.
         g = 0.0;
