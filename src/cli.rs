@@ -265,11 +265,16 @@ pub struct DeviceArgs {
     pub validation: bool,
 }
 
-#[derive(Args, Debug)]
+#[derive(Args, Debug, Clone)]
 pub struct RenderArgs {
-    /// Mesh: `sphere`, `box`, `slab`, `torus`, or the path of an OBJ file (default: the Stanford
-    /// bunny from glmark2-data when installed, else the sphere). A `{frame}` in the path plays a
-    /// sequence of files, one per frame (numbered from 0 or 1, plain or padded to 4 digits).
+    /// A pbrt-v4 scene file (`scene.pbrt`): its camera, film, shape, material and lights; flags
+    /// typed here override them (see README, "Scenes").
+    #[arg(value_name = "SCENE.pbrt")]
+    pub scene: Option<PathBuf>,
+    /// Mesh: `sphere`, `box`, `slab`, `torus`, or the path of a mesh file: `.obj`, `.ply`, `.off`,
+    /// any of them gzip-compressed (`.ply.gz`) (default: the Stanford bunny from glmark2-data when
+    /// installed, else the sphere). A `{frame}` in the path plays a sequence of files, one per
+    /// frame (numbered from 0 or 1, plain or padded to 4 digits).
     #[arg(long)]
     pub mesh: Option<String>,
     /// Output image; the extension picks the format (.png or .exr). A `{frame}` in the name

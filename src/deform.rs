@@ -156,7 +156,7 @@ impl Animation {
                 let index = first + frame % count;
                 let path = sequence_file(pattern, index)
                     .ok_or_else(|| bad_input!("--mesh {pattern}: frame {index} is missing"))?;
-                Mesh::load_obj(Path::new(&path))?
+                Mesh::load(Path::new(&path))?
             }
         };
         Ok(match self.deformation {
@@ -182,7 +182,7 @@ pub fn first_mesh(spec: &str) -> Result<Mesh> {
     if spec.contains("{frame}") {
         let (first, _) = sequence_range(spec)?;
         let path = sequence_file(spec, first).expect("found by sequence_range");
-        return Mesh::load_obj(Path::new(&path));
+        return Mesh::load(Path::new(&path));
     }
     Mesh::from_spec(spec)
 }

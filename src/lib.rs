@@ -21,6 +21,7 @@ pub mod mesh;
 pub mod models;
 pub mod output;
 pub mod passes;
+pub mod pbrt;
 pub mod physics;
 pub mod plot;
 pub mod profiling;

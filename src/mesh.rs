@@ -1,10 +1,14 @@
-//! Triangle meshes: OBJ files through tobj (with the checks tobj does not make) and procedural
+//! Triangle meshes: OBJ files through tobj (with the checks tobj does not make), PLY files
+//! through ply-rs-bw ([`ply`]), OFF files ([`off`]), any of them gzip-compressed, and procedural
 //! shapes. One index stream is shared by positions and normals.
+
+pub mod off;
+pub mod ply;
 
 use std::f32::consts::PI;
 use std::path::Path;
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 use crate::bad_input;
 use crate::error::Result;
@@ -17,16 +21,112 @@ pub struct Mesh {
     pub indices: Vec<u32>,
 }
 
+/// A mesh as a file gives it, before the checks and repairs every format shares
+/// ([`Mesh::from_raw`]): triangles (polygons already fanned), indices into the vertices.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RawMesh {
+    pub positions: Vec<Vec3>,
+    /// Per vertex, when the file gives them (for every vertex).
+    pub normals: Option<Vec<Vec3>>,
+    /// Texture coordinates per vertex, when the file gives them.
+    pub uvs: Option<Vec<Vec2>>,
+    pub indices: Vec<u32>,
+}
+
+/// The mesh file formats, chosen by the file's extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MeshFormat {
+    Obj,
+    Ply,
+    Off,
+}
+
+impl MeshFormat {
+    /// The format named by a path's extension (`.ply`, `.off`, anything else OBJ), and whether
+    /// the file is gzip-compressed (`.gz` after it: `bunny.ply.gz`).
+    pub fn of(path: &Path) -> (MeshFormat, bool) {
+        let name = path.file_name().map(|n| n.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
+        let (name, gz) = match name.strip_suffix(".gz") {
+            Some(inner) => (inner.to_string(), true),
+            None => (name, false),
+        };
+        let format = if name.ends_with(".ply") {
+            MeshFormat::Ply
+        } else if name.ends_with(".off") {
+            MeshFormat::Off
+        } else {
+            MeshFormat::Obj
+        };
+        (format, gz)
+    }
+}
+
+/// The largest number of vertices, faces or triangles read from a PLY or OFF file: past any real
+/// scan (Lucy has 14M vertices and 28M triangles), and a bound on what a header's counts may make
+/// the reader allocate.
+pub const MAX_ELEMENTS: usize = 1 << 25;
+
+/// Reads a mesh file as its format gives it (by extension, gunzipped first for `.gz`), checked
+/// as [`Mesh::load`] checks it but not yet validated or repaired: for callers that transform it
+/// first (scene files).
+pub fn read_raw(path: &Path) -> Result<RawMesh> {
+    let shown = path.display().to_string();
+    let (format, gz) = MeshFormat::of(path);
+    let mut bytes = read_mesh_file(path)?;
+    if gz {
+        bytes = gunzip(&bytes, &shown)?;
+    }
+    raw_from_bytes(&bytes, format, &shown)
+}
+
+/// The file's triangles as its format gives them; errors name `shown` and the line.
+pub fn raw_from_bytes(bytes: &[u8], format: MeshFormat, shown: &str) -> Result<RawMesh> {
+    match format {
+        MeshFormat::Obj => Mesh::raw_from_obj_bytes(bytes, shown),
+        MeshFormat::Ply => ply::read(bytes).map_err(|why| bad_input!("mesh {shown}: {why}")),
+        MeshFormat::Off => off::read(bytes).map_err(|why| bad_input!("mesh {shown}: {why}")),
+    }
+}
+
+/// Decompresses a gzip file, bounded like an uncompressed one (a small file that inflates past
+/// [`MAX_MESH_BYTES`] is refused as it is read, not after).
+pub fn gunzip(bytes: &[u8], shown: &str) -> Result<Vec<u8>> {
+    use std::io::Read;
+    let mut out = Vec::new();
+    flate2::read::MultiGzDecoder::new(bytes)
+        .take(MAX_MESH_BYTES + 1)
+        .read_to_end(&mut out)
+        .map_err(|e| bad_input!("mesh {shown}: not a readable gzip file: {e}"))?;
+    if out.len() as u64 > MAX_MESH_BYTES {
+        return Err(bad_input!("mesh {shown}: decompresses to more than the limit of {} MiB", MAX_MESH_BYTES >> 20));
+    }
+    Ok(out)
+}
+
 impl Mesh {
-    /// `sphere`, `box`, `slab`, `torus`, or the path of an OBJ file.
+    /// `sphere`, `box`, `slab`, `torus`, or the path of a mesh file (OBJ, PLY, OFF; see [`Mesh::load`]).
     pub fn from_spec(spec: &str) -> Result<Mesh> {
         match spec {
             "sphere" => Ok(Mesh::sphere(1.0, 48)),
             "box" => Ok(Mesh::slab(1.0, 1.0, 1.0)),
             "slab" => Ok(Mesh::slab(4.0, 4.0, 1.0)),
             "torus" => Ok(Mesh::torus(1.0, 0.35, 64, 32)),
-            path => Mesh::load_obj(Path::new(path)),
+            path => Mesh::load(Path::new(path)),
         }
+    }
+
+    /// Loads a mesh file, its format chosen by the extension: `.ply`, `.off`, anything else OBJ,
+    /// each optionally gzip-compressed (`.ply.gz`). The same checks and repairs for every format
+    /// ([`Mesh::from_raw`]).
+    pub fn load(path: &Path) -> Result<Mesh> {
+        let (format, _) = MeshFormat::of(path);
+        let raw = read_raw(path)?;
+        Mesh::from_raw(raw, &path.display().to_string(), format)
+    }
+
+    /// Mesh bytes of a format (uncompressed); errors name `shown`.
+    pub fn from_bytes(bytes: &[u8], format: MeshFormat, shown: &str) -> Result<Mesh> {
+        Mesh::from_raw(raw_from_bytes(bytes, format, shown)?, shown, format)
     }
 
     /// Loads every object of an OBJ file into one mesh (triangulated, single index). Computes smooth
@@ -38,6 +138,11 @@ impl Mesh {
     /// Parses OBJ text (`shown` names it in errors). A UTF-8 byte-order mark is skipped and
     /// old-Mac CR-only line endings are read as line ends, like LF and CRLF.
     pub fn from_obj_bytes(bytes: &[u8], shown: &str) -> Result<Mesh> {
+        Mesh::from_raw(Mesh::raw_from_obj_bytes(bytes, shown)?, shown, MeshFormat::Obj)
+    }
+
+    /// OBJ text as triangles, checked line by line but not yet validated.
+    fn raw_from_obj_bytes(bytes: &[u8], shown: &str) -> Result<RawMesh> {
         let text = std::str::from_utf8(bytes).map_err(|e| {
             bad_input!("mesh {shown}: not an OBJ file (not UTF-8 text: byte {} is invalid)", e.valid_up_to() + 1)
         })?;
@@ -77,6 +182,29 @@ impl Mesh {
                 mesh.indices.push(base + i);
             }
         }
+        Ok(RawMesh {
+            positions: mesh.positions,
+            normals: have_normals.then_some(mesh.normals),
+            uvs: None,
+            indices: mesh.indices,
+        })
+    }
+
+    /// The checks and repairs every file format shares: [`Mesh::validate`]; a closed mesh wound
+    /// inside out turned outward; the file's normals normalised (computed when it has none or an
+    /// unusable one), and turned outward when they point inward on a closed mesh. Each repair
+    /// prints a warning naming `shown`.
+    pub fn from_raw(raw: RawMesh, shown: &str, format: MeshFormat) -> Result<Mesh> {
+        let what = match format {
+            MeshFormat::Obj => "vn normals",
+            MeshFormat::Ply | MeshFormat::Off => "normals",
+        };
+        let have_normals = raw.normals.as_ref().is_some_and(|n| n.len() == raw.positions.len());
+        let normals = match raw.normals {
+            Some(n) if have_normals => n,
+            _ => vec![Vec3::ZERO; raw.positions.len()],
+        };
+        let mut mesh = Mesh { positions: raw.positions, normals, indices: raw.indices };
         mesh.validate().map_err(|e| bad_input!("mesh {shown}: {e}"))?;
         // Inside-out meshes render dark: a closed mesh enclosing negative volume is wound inward.
         if mesh.is_closed() && mesh.signed_volume() < 0.0 {
@@ -97,10 +225,10 @@ impl Mesh {
                 for n in &mut mesh.normals {
                     *n = -*n;
                 }
-                crate::note!("warning: mesh {shown}: its vn normals point inward; turned outward");
+                crate::note!("warning: mesh {shown}: its {what} point inward; turned outward");
             } else {
                 crate::note!(
-                    "warning: mesh {shown}: most vn normals point against the triangles' winding; the surface may render dark"
+                    "warning: mesh {shown}: most {what} point against the triangles' winding; the surface may render dark"
                 );
             }
         }

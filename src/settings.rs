@@ -146,7 +146,7 @@ impl SceneSettings {
 /// units a power of two larger or smaller, so that its radius is near 1: the picture is the same
 /// (millimetres per unit change by the inverse factor, exactly), but the hierarchy's half-float
 /// node bounds and the depth range keep their precision.
-fn rescaled(mut scene: Scene, radius: f32) -> Scene {
+pub(crate) fn rescaled(mut scene: Scene, radius: f32) -> Scene {
     if (1.0 / 64.0..=64.0).contains(&radius) || radius.is_nan() || radius <= 0.0 {
         return scene;
     }

@@ -1,4 +1,4 @@
-//! Property tests of the readers and the flag parsers with generated inputs (proptest): no panic,
+//! Property tests of the readers (OBJ, PLY, OFF, CSV) and the flag parsers with generated inputs (proptest): no panic,
 //! and every input either loads into something the renderer can use or is refused as bad input
 //! (exit code 2) with a message naming the file or flag.
 //!
@@ -11,7 +11,7 @@ use proptest::test_runner::{Config, RngAlgorithm, TestCaseError, TestRng, TestRu
 
 use translucent::bssrdf_csv::{self, Reader};
 use translucent::cli::{Cli, Command};
-use translucent::mesh::Mesh;
+use translucent::mesh::{Mesh, MeshFormat};
 
 // ---------- generators ----------
 
@@ -98,6 +98,253 @@ fn obj_text() -> impl Strategy<Value = Vec<u8>> {
             text.into_bytes()
         },
     )
+}
+
+/// A PLY header from parts a writer (or an attacker) might use, then a body of number lines
+/// (ASCII) or bytes (binary): counts, types and names both valid and hostile.
+fn ply_text() -> impl Strategy<Value = Vec<u8>> {
+    let format = prop::sample::select(vec!["ascii", "binary_little_endian", "binary_big_endian", "binary", ""]);
+    let count = prop_oneof![4 => 0u64..6, 1 => any::<u64>(), 1 => Just(1u64 << 40)];
+    let scalar = prop::sample::select(vec![
+        "char", "uchar", "short", "ushort", "int", "uint", "float", "double", "int8", "float32", "list",
+    ]);
+    let name = prop::sample::select(vec![
+        "x",
+        "y",
+        "z",
+        "nx",
+        "ny",
+        "nz",
+        "u",
+        "v",
+        "s",
+        "t",
+        "confidence",
+        "intensity",
+        "vertex_indices",
+        "vertex_index",
+        "red",
+    ]);
+    let property = prop_oneof![
+        3 => (scalar.clone(), name.clone()).prop_map(|(t, n)| format!("property {t} {n}")),
+        1 => (scalar.clone(), scalar, name).prop_map(|(c, t, n)| format!("property list {c} {t} {n}")),
+    ];
+    let element = (
+        prop::sample::select(vec!["vertex", "face", "edge", "material", "vertex"]),
+        count,
+        prop::collection::vec(property, 0..6),
+    )
+        .prop_map(|(e, n, props)| format!("element {e} {n}\n{}", props.join("\n")));
+    let extra = prop::sample::select(vec![
+        "comment made by hand",
+        "obj_info scanner 1",
+        "",
+        "end_header",
+        "ply",
+        "format ascii 2.0",
+    ]);
+    let body_line = prop::collection::vec(prop_oneof![number(), (-3i64..8).prop_map(|i| i.to_string())], 0..8)
+        .prop_map(|v| v.join(" "));
+    (
+        format,
+        prop::collection::vec(element, 0..4),
+        prop::collection::vec(extra, 0..2),
+        prop::collection::vec(body_line, 0..12),
+        prop::collection::vec(any::<u8>(), 0..200),
+    )
+        .prop_map(|(format, elements, extra, lines, bytes)| {
+            let mut out =
+                format!("ply\nformat {format} 1.0\n{}\n{}\nend_header\n", extra.join("\n"), elements.join("\n"))
+                    .replace("\n\n", "\n")
+                    .into_bytes();
+            if format == "ascii" {
+                out.extend(lines.join("\n").into_bytes());
+            } else {
+                out.extend(bytes);
+            }
+            out
+        })
+}
+
+/// pbrt-v4 scene text: directives (known and not), parameter lists with declared types and
+/// values of every kind, brackets, strings with escapes, comments; valid and hostile.
+fn pbrt_text() -> impl Strategy<Value = Vec<u8>> {
+    let directive = prop::sample::select(vec![
+        "LookAt",
+        "Camera",
+        "Film",
+        "Scale",
+        "Translate",
+        "Rotate",
+        "Transform",
+        "ConcatTransform",
+        "Identity",
+        "CoordinateSystem",
+        "CoordSysTransform",
+        "ReverseOrientation",
+        "AttributeBegin",
+        "AttributeEnd",
+        "WorldBegin",
+        "MakeNamedMaterial",
+        "NamedMaterial",
+        "Material",
+        "Texture",
+        "Shape",
+        "LightSource",
+        "Sampler",
+        "Option",
+        "Include",
+        "ObjectBegin",
+        "Frobnicate",
+        "TransformBegin",
+        "TransformEnd",
+    ]);
+    let word = prop::sample::select(vec![
+        "\"perspective\"",
+        "\"subsurface\"",
+        "\"diffuse\"",
+        "\"sphere\"",
+        "\"trianglemesh\"",
+        "\"distant\"",
+        "\"point\"",
+        "\"spot\"",
+        "\"infinite\"",
+        "\"checkerboard\"",
+        "\"spectrum\"",
+        "\"rgb\"",
+        "\"camera\"",
+        "\"a\\\"b\"",
+        "\"x.pbrt\"",
+        "\"\"",
+        "[",
+        "]",
+        "true",
+        "#c\n",
+        "\"Skin1\"",
+    ]);
+    let decl = (
+        prop::sample::select(vec![
+            "float",
+            "integer",
+            "rgb",
+            "spectrum",
+            "point3",
+            "normal",
+            "point2",
+            "string",
+            "texture",
+            "bool",
+            "blackbody",
+            "quaternion",
+        ]),
+        prop::sample::select(vec![
+            "fov",
+            "P",
+            "indices",
+            "N",
+            "uv",
+            "radius",
+            "name",
+            "sigma_a",
+            "sigma_s",
+            "reflectance",
+            "mfp",
+            "L",
+            "from",
+            "to",
+            "scale",
+            "xresolution",
+            "type",
+            "filename",
+            "tex1",
+        ]),
+    )
+        .prop_map(|(t, n)| format!("\"{t} {n}\""));
+    let value = prop_oneof![
+        number(),
+        (-3i64..12).prop_map(|i| i.to_string()),
+        prop::collection::vec((-3i64..12).prop_map(|i| i.to_string()), 0..10)
+            .prop_map(|v| format!("[ {} ]", v.join(" "))),
+        word.clone().prop_map(str::to_string),
+    ];
+    let item = prop_oneof![
+        3 => directive.prop_map(str::to_string),
+        2 => word.prop_map(str::to_string),
+        3 => (decl, value.clone()).prop_map(|(d, v)| format!("{d} {v}")),
+        2 => value,
+        1 => "[ -~]{0,12}",
+    ];
+    prop::collection::vec(item, 0..40).prop_map(|v| v.join(" ").into_bytes())
+}
+
+/// OFF text: keyword, counts and records, valid and hostile, with comments and blank lines.
+fn off_text() -> impl Strategy<Value = Vec<u8>> {
+    let keyword = prop::sample::select(vec!["OFF", "NOFF", "COFF", "STOFF", "CNOFF", "4OFF", "nOFF", "off", ""]);
+    let count = prop_oneof![4 => (0u64..6).prop_map(|v| v.to_string()), 1 => any::<u64>().prop_map(|v| v.to_string()), 1 => number()];
+    let line = prop_oneof![
+        3 => (number(), number(), number()).prop_map(|(a, b, c)| format!("{a} {b} {c}")),
+        3 => (-2.0f32..2.0, -2.0f32..2.0, -2.0f32..2.0).prop_map(|(a, b, c)| format!("{a} {b} {c}")),
+        3 => prop::collection::vec(-2i64..8, 1..7).prop_map(|v| v.iter().map(|i| i.to_string()).collect::<Vec<_>>().join(" ")),
+        1 => Just("# a comment".to_string()),
+        1 => Just(String::new()),
+        1 => "[ -~]{0,20}",
+    ];
+    (keyword, count.clone(), count, any::<bool>(), prop::collection::vec(line, 0..20)).prop_map(
+        |(keyword, nv, nf, same_line, lines)| {
+            let counts = format!("{nv} {nf} 0");
+            let head = if same_line { format!("{keyword} {counts}") } else { format!("{keyword}\n{counts}") };
+            format!("{head}\n{}\n", lines.join("\n")).into_bytes()
+        },
+    )
+}
+
+/// A valid mesh's data: positions, and polygons (3 to 5 corners) indexing them.
+fn polygon_mesh() -> impl Strategy<Value = (Vec<[f32; 3]>, Vec<Vec<u32>>)> {
+    prop::collection::vec(prop::array::uniform3(-1e3f32..1e3), 3..30).prop_flat_map(|positions| {
+        let n = positions.len() as u32;
+        (Just(positions), prop::collection::vec(prop::collection::vec(0..n, 3..6), 1..30))
+    })
+}
+
+/// The mesh as PLY (encoding 0 ASCII, 1 little, 2 big endian) or, for encoding 3, OFF.
+fn write_mesh(positions: &[[f32; 3]], faces: &[Vec<u32>], encoding: usize) -> Vec<u8> {
+    if encoding == 3 {
+        let mut s = format!("OFF\n{} {} 0\n", positions.len(), faces.len());
+        for p in positions {
+            s += &format!("{} {} {}\n", p[0], p[1], p[2]);
+        }
+        for f in faces {
+            s += &format!("{} {}\n", f.len(), f.iter().map(|i| i.to_string()).collect::<Vec<_>>().join(" "));
+        }
+        return s.into_bytes();
+    }
+    let format = ["ascii", "binary_little_endian", "binary_big_endian"][encoding];
+    let mut out = format!(
+        "ply\nformat {format} 1.0\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\n\
+         element face {}\nproperty list uchar uint vertex_indices\nend_header\n",
+        positions.len(),
+        faces.len()
+    )
+    .into_bytes();
+    let big = encoding == 2;
+    for p in positions {
+        if encoding == 0 {
+            out.extend(format!("{} {} {}\n", p[0], p[1], p[2]).into_bytes());
+        } else {
+            p.iter().for_each(|c| out.extend(if big { c.to_be_bytes() } else { c.to_le_bytes() }));
+        }
+    }
+    for f in faces {
+        if encoding == 0 {
+            out.extend(
+                format!("{} {}\n", f.len(), f.iter().map(|i| i.to_string()).collect::<Vec<_>>().join(" ")).into_bytes(),
+            );
+        } else {
+            out.push(f.len() as u8);
+            f.iter().for_each(|i| out.extend(if big { i.to_be_bytes() } else { i.to_le_bytes() }));
+        }
+    }
+    out
 }
 
 fn csv_row() -> impl Strategy<Value = String> {
@@ -197,7 +444,21 @@ fn argv() -> impl Strategy<Value = Vec<String>> {
 // ---------- properties ----------
 
 fn check_obj(bytes: &[u8]) -> Result<(), TestCaseError> {
-    match Mesh::from_obj_bytes(bytes, "fuzz.obj") {
+    check_mesh(bytes, MeshFormat::Obj)
+}
+
+/// Any bytes either load into a valid mesh or are refused as bad input naming the file.
+fn check_mesh(bytes: &[u8], format: MeshFormat) -> Result<(), TestCaseError> {
+    let shown = match format {
+        MeshFormat::Obj => "fuzz.obj",
+        MeshFormat::Ply => "fuzz.ply",
+        MeshFormat::Off => "fuzz.off",
+    };
+    let loaded = match format {
+        MeshFormat::Obj => Mesh::from_obj_bytes(bytes, shown),
+        _ => Mesh::from_bytes(bytes, format, shown),
+    };
+    match loaded {
         Ok(mesh) => {
             prop_assert!(mesh.validate().is_ok(), "loaded but invalid: {:?}", mesh.validate().err());
             prop_assert!(mesh.positions.iter().all(|p| p.is_finite()));
@@ -210,7 +471,55 @@ fn check_obj(bytes: &[u8]) -> Result<(), TestCaseError> {
         }
         Err(e) => {
             prop_assert_eq!(e.exit_code(), 2, "{}", e);
-            prop_assert!(e.to_string().contains("fuzz.obj"), "error does not name the file: {}", e);
+            prop_assert!(e.to_string().contains(shown), "error does not name the file: {}", e);
+        }
+    }
+    Ok(())
+}
+
+/// A generated mesh written as PLY or OFF reads back to exactly its positions and fanned polygons.
+fn check_round_trip(positions: &[[f32; 3]], faces: &[Vec<u32>], encoding: usize) -> Result<(), TestCaseError> {
+    let format = if encoding == 3 { MeshFormat::Off } else { MeshFormat::Ply };
+    let raw = translucent::mesh::raw_from_bytes(&write_mesh(positions, faces, encoding), format, "round-trip")
+        .map_err(|e| TestCaseError::fail(e.to_string()))?;
+    let expected: Vec<glam::Vec3> = positions.iter().map(|p| glam::Vec3::from(*p)).collect();
+    prop_assert_eq!(&raw.positions, &expected);
+    let fanned: Vec<u32> =
+        faces.iter().flat_map(|f| (1..f.len() - 1).flat_map(move |k| [f[0], f[k], f[k + 1]])).collect();
+    prop_assert_eq!(&raw.indices, &fanned);
+    Ok(())
+}
+
+/// A scene file either loads (every object's vertices finite, indices in range) or is refused as
+/// bad input whose message begins with the file's path (FILE:LINE:COLUMN).
+fn check_pbrt(bytes: &[u8]) -> Result<(), TestCaseError> {
+    thread_local!(static DIR: std::path::PathBuf = {
+        let d = std::env::temp_dir().join(format!("translucent-fuzz-pbrt-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    });
+    let path = DIR.with(|d| d.join(format!("fuzz-{:?}.pbrt", std::thread::current().id())));
+    std::fs::write(&path, bytes).unwrap();
+    match translucent::pbrt::load(&path) {
+        Ok(scene) => {
+            for o in &scene.objects {
+                prop_assert!(o.mesh.positions.iter().all(|p| p.is_finite()));
+                prop_assert!(o.mesh.indices.iter().all(|&i| (i as usize) < o.mesh.positions.len()));
+            }
+        }
+        Err(e) => {
+            prop_assert_eq!(e.exit_code(), 2, "{}", e);
+            prop_assert!(
+                e.to_string().starts_with(&*path.parent().unwrap().to_string_lossy()),
+                "error does not name the file: {}",
+                e
+            );
+        }
+    }
+    // The tokenizer alone, on the same text as a string: never a panic, errors located.
+    if let Ok(text) = std::str::from_utf8(bytes) {
+        if let Err(e) = translucent::pbrt::tokenizer::tokenize(text, "t") {
+            prop_assert!(e.starts_with("t:"), "{}", e);
         }
     }
     Ok(())
@@ -381,6 +690,31 @@ fn obj_reader_properties() {
 }
 
 #[test]
+fn ply_and_off_reader_properties() {
+    run_cases(&ply_text(), CI_CASES, 6, |b| check_mesh(&b, MeshFormat::Ply));
+    run_cases(&prop::collection::vec(any::<u8>(), 0..400), CI_CASES, 7, |b| check_mesh(&b, MeshFormat::Ply));
+    run_cases(&off_text(), CI_CASES, 8, |b| check_mesh(&b, MeshFormat::Off));
+    run_cases(&prop::collection::vec(any::<u8>(), 0..400), CI_CASES, 9, |b| check_mesh(&b, MeshFormat::Off));
+    run_cases(&(polygon_mesh(), 0usize..4), 400, 10, |((p, f), e)| check_round_trip(&p, &f, e));
+    // A valid file with a few bytes changed: near-valid input reaches the deep checks.
+    let mutated = (polygon_mesh(), 0usize..4, prop::collection::vec((any::<prop::sample::Index>(), any::<u8>()), 1..4));
+    run_cases(&mutated, CI_CASES, 11, |((p, f), e, edits)| {
+        let mut bytes = write_mesh(&p, &f, e);
+        for (at, b) in edits {
+            let i = at.index(bytes.len());
+            bytes[i] = b;
+        }
+        check_mesh(&bytes, if e == 3 { MeshFormat::Off } else { MeshFormat::Ply })
+    });
+}
+
+#[test]
+fn pbrt_reader_properties() {
+    run_cases(&pbrt_text(), CI_CASES, 12, |b| check_pbrt(&b));
+    run_cases(&prop::collection::vec(any::<u8>(), 0..400), 500, 13, |b| check_pbrt(&b));
+}
+
+#[test]
 fn csv_reader_properties() {
     run_cases(&csv_text(), CI_CASES, 3, |b| check_csv(&b));
     run_cases(&prop::collection::vec(any::<u8>(), 0..400), CI_CASES, 4, |b| check_csv(&b));
@@ -396,6 +730,22 @@ fn flag_parser_properties() {
 fn fuzz_obj_reader() {
     fuzz_for("OBJ reader (grammar)", obj_text(), |b| check_obj(&b));
     fuzz_for("OBJ reader (bytes)", prop::collection::vec(any::<u8>(), 0..2000), |b| check_obj(&b));
+}
+
+#[test]
+#[ignore]
+fn fuzz_ply_and_off_readers() {
+    fuzz_for("PLY reader (grammar)", ply_text(), |b| check_mesh(&b, MeshFormat::Ply));
+    fuzz_for("PLY reader (bytes)", prop::collection::vec(any::<u8>(), 0..2000), |b| check_mesh(&b, MeshFormat::Ply));
+    fuzz_for("OFF reader (grammar)", off_text(), |b| check_mesh(&b, MeshFormat::Off));
+    fuzz_for("mesh round trip", (polygon_mesh(), 0usize..4), |((p, f), e)| check_round_trip(&p, &f, e));
+}
+
+#[test]
+#[ignore]
+fn fuzz_pbrt_reader() {
+    fuzz_for("pbrt-v4 reader (grammar)", pbrt_text(), |b| check_pbrt(&b));
+    fuzz_for("pbrt-v4 reader (bytes)", prop::collection::vec(any::<u8>(), 0..2000), |b| check_pbrt(&b));
 }
 
 #[test]

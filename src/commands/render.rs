@@ -12,11 +12,20 @@ use super::{check_output_path, frame_path};
 
 pub(super) fn render(args: &RenderArgs) -> Result<i32> {
     // Check everything the user typed before the (slow) device start.
+    if let Some(scene) = &args.scene {
+        let argv: Vec<String> = std::env::args().collect();
+        let (args, settings) = crate::pbrt::render_settings(scene, args, &|f| crate::pbrt::flag_given(&argv, f))?;
+        return render_settings(&args, settings);
+    }
+    render_settings(args, RenderSettings::from_args(args)?)
+}
+
+fn render_settings(args: &RenderArgs, settings: RenderSettings) -> Result<i32> {
     check_output_path(&args.out, "--out", &["png", "exr"])?;
     if let Some(p) = &args.profile_out {
         check_output_path(p, "--profile-out", &["json"])?;
     }
-    let RenderSettings { mut world, mut desc, profile } = RenderSettings::from_args(args)?;
+    let RenderSettings { mut world, mut desc, profile } = settings;
     let ctx = Context::new(&args.device.options())?;
     let counts = ctx.validation_counts();
     let validating = ctx.validation;

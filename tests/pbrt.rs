@@ -1,0 +1,275 @@
+//! pbrt-v4 scene files: transformations checked against meshes transformed by hand, the four forms
+//! of the subsurface material, every refusal class (exit 2, FILE:LINE:COLUMN), and renders through
+//! the command line (the camera's handedness, flags overriding the scene).
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use glam::{DMat4, DVec3, Vec3};
+use translucent::pbrt::{self, LightDesc, MaterialDesc, Reflectance, SubsurfaceSource};
+
+fn dir(name: &str) -> PathBuf {
+    let d = common::output_dir().join("pbrt").join(name);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+const TRI: &str =
+    r#"Shape "trianglemesh" "point3 P" [0 0 0  1 0 0  0 1 0] "integer indices" [0 1 2] "normal N" [0 0 1 0 0 1 0 0 1]"#;
+
+fn close(a: Vec3, b: DVec3) -> bool {
+    (a.as_dvec3() - b).length() < 1e-5
+}
+
+#[test]
+fn transformations_match_a_mesh_transformed_by_hand() {
+    let d = dir("transforms");
+    let text = format!(
+        "WorldBegin\nTranslate 1 2 3\nAttributeBegin\n  Rotate 90 0 0 1\n  AttributeBegin\n    Scale 2 2 2\n    {TRI}\n  AttributeEnd\n  {TRI}\nAttributeEnd\n{TRI}\n\
+         AttributeBegin\n  Scale -1 1 1\n  {TRI}\nAttributeEnd\nAttributeBegin\n  ReverseOrientation\n  {TRI}\nAttributeEnd\n\
+         AttributeBegin\n  CoordinateSystem \"here\"\n  Identity\n  CoordSysTransform \"here\"\n  ConcatTransform [1 0 0 0  0 1 0 0  0 0 1 0  5 0 0 1]\n  {TRI}\nAttributeEnd\n"
+    );
+    let scene = pbrt::load(&write(&d, "t.pbrt", &text)).unwrap();
+    assert_eq!(scene.objects.len(), 6);
+    let tri = [DVec3::ZERO, DVec3::X, DVec3::Y];
+    let t = DMat4::from_translation(DVec3::new(1.0, 2.0, 3.0));
+    let r = DMat4::from_axis_angle(DVec3::Z, 90f64.to_radians());
+    let expected = [
+        (t * r * DMat4::from_scale(DVec3::splat(2.0)), false),
+        (t * r, false),
+        (t, false),
+        (t * DMat4::from_scale(DVec3::new(-1.0, 1.0, 1.0)), true), // handedness swapped: winding turned
+        (t, true),                                                 // ReverseOrientation
+        (t * DMat4::from_translation(DVec3::new(5.0, 0.0, 0.0)), false),
+    ];
+    for (k, ((m, turned), object)) in expected.iter().zip(&scene.objects).enumerate() {
+        let mesh = &object.mesh;
+        let order = if *turned { [0, 2, 1] } else { [0, 1, 2] };
+        for (corner, &v) in order.iter().enumerate() {
+            let p = mesh.positions[mesh.indices[corner] as usize];
+            assert!(close(p, m.transform_point3(tri[v])), "object {k} corner {corner}: {p}");
+        }
+        // The normals: transformed as normals, and negated by ReverseOrientation.
+        let n = mesh.normals.as_ref().unwrap()[0];
+        let want = m.inverse().transpose().transform_vector3(DVec3::Z).normalize() * if k == 4 { -1.0 } else { 1.0 };
+        assert!(close(n, want), "object {k}: normal {n} vs {want}");
+        // The winding's normal agrees with the normals (outward by pbrt's rule).
+        let [a, b, c] = [0, 1, 2].map(|i| mesh.positions[mesh.indices[i] as usize]);
+        assert!((b - a).cross(c - a).dot(n) > 0.0, "object {k}: winding against its normal");
+        assert_eq!(object.loc.file.as_ref(), d.join("t.pbrt").display().to_string());
+    }
+    assert_eq!(scene.objects[0].loc.line, 7);
+}
+
+#[test]
+fn materials_lights_textures_and_includes() {
+    let d = dir("materials");
+    std::fs::create_dir_all(d.join("inc")).unwrap();
+    write(
+        &d,
+        "inc/part.pbrt",
+        &format!("Material \"subsurface\" \"rgb reflectance\" [0.6 0.5 0.4] \"rgb mfp\" [1 2 3]\n{TRI}\n"),
+    );
+    let text = format!(
+        "LookAt 0 0 -5 0 0 0 0 1 0\nCamera \"perspective\" \"float fov\" 45\nFilm \"rgb\" \"integer xresolution\" 64 \"integer yresolution\" 32 \"string filename\" \"x.exr\"\n\
+         WorldBegin\nLightSource \"distant\" \"point3 from\" [0 1 0] \"point3 to\" [0 0 0] \"rgb L\" [1 2 3] \"float scale\" 2\n\
+         LightSource \"point\" \"point3 from\" [1 2 3] \"spectrum I\" [400 1 700 1]\nLightSource \"spot\" \"float coneangle\" 20\nLightSource \"infinite\" \"rgb L\" [.1 .1 .1]\n\
+         MakeNamedMaterial \"milk\" \"string type\" \"subsurface\" \"string name\" \"Lowfat Milk\" \"float g\" 0.5 \"float scale\" 3\n\
+         NamedMaterial \"milk\"\n{TRI}\nMaterial \"subsurface\" \"rgb sigma_a\" [1 2 3] \"rgb sigma_s\" [4 5 6] \"float eta\" 1.5 \"float g\" 0.2\n{TRI}\n\
+         Material \"subsurface\"\n{TRI}\nInclude \"inc/part.pbrt\"\n\
+         Texture \"c\" \"spectrum\" \"checkerboard\" \"float uscale\" 4 \"float vscale\" 2 \"rgb tex1\" [1 0 0] \"rgb tex2\" [0 0 1]\n\
+         Material \"diffuse\" \"texture reflectance\" \"c\"\n{TRI}\nTexture \"i\" \"spectrum\" \"imagemap\" \"string filename\" \"wood.png\"\nMaterial \"diffuse\" \"texture reflectance\" \"i\"\n{TRI}\n\
+         Shape \"sphere\" \"float radius\" 2\n"
+    );
+    let scene = pbrt::load(&write(&d, "m.pbrt", &text)).unwrap();
+    let cam = scene.camera.as_ref().unwrap();
+    assert!(cam.left_handed && (cam.eye - DVec3::new(0.0, 0.0, -5.0)).length() < 1e-12 && cam.fov_deg == 45.0);
+    assert_eq!(
+        (scene.film.xresolution, scene.film.yresolution, scene.film.filename.as_deref()),
+        (64, 32, Some("x.exr"))
+    );
+    assert!(matches!(scene.lights[0], LightDesc::Distant { l: [1.0, 2.0, 3.0], scale: 2.0, .. }));
+    assert!(matches!(scene.lights[1], LightDesc::Point { i: [1.0, 1.0, 1.0], .. }));
+    assert!(matches!(scene.lights[2], LightDesc::Spot { coneangle: 20.0, .. }));
+    assert!(matches!(scene.lights[3], LightDesc::Infinite { l: Some(_), .. }));
+    let sub = |k: usize| match &scene.objects[k].material {
+        MaterialDesc::Subsurface(s) => s.clone(),
+        m => panic!("object {k}: {m:?}"),
+    };
+    // Named: pbrt's own values (not the Narasimhan paper's), g forced to 0, scale kept.
+    let milk = sub(0);
+    assert_eq!(
+        (milk.sigma_s, milk.sigma_a, milk.g, milk.scale),
+        ([0.89187, 1.5136, 2.532], [0.002875, 0.00575, 0.0115], 0.0, 3.0)
+    );
+    assert_eq!(milk.source, SubsurfaceSource::Named("Lowfat Milk".into()));
+    let coeff = sub(1);
+    assert_eq!((coeff.sigma_a, coeff.sigma_s, coeff.eta, coeff.g), ([1.0, 2.0, 3.0], [4.0, 5.0, 6.0], 1.5, 0.2));
+    let default = sub(2);
+    assert_eq!((default.sigma_a, default.sigma_s, default.eta), ([0.0011, 0.0024, 0.014], [2.55, 3.21, 3.77], 1.33));
+    let refl = sub(3);
+    assert!(matches!(refl.source, SubsurfaceSource::Reflectance { .. }));
+    assert!((1.0 / (refl.sigma_a[1] + refl.sigma_s[1]) - 2.0).abs() < 1e-12, "mfp 2 in green");
+    assert_eq!(refl.loc.file.as_ref(), d.join("inc/part.pbrt").display().to_string());
+    match &scene.objects[4].material {
+        MaterialDesc::Diffuse { reflectance: Reflectance::Checkerboard { uscale, vscale, tex1, tex2 } } => {
+            assert_eq!((*uscale, *vscale), (4.0, 2.0));
+            assert_eq!((**tex1).clone(), Reflectance::Constant([1.0, 0.0, 0.0]));
+            assert_eq!((**tex2).clone(), Reflectance::Constant([0.0, 0.0, 1.0]));
+        }
+        m => panic!("{m:?}"),
+    }
+    assert!(
+        matches!(&scene.objects[5].material, MaterialDesc::Diffuse { reflectance: Reflectance::ImageMap { path } } if path.ends_with("wood.png"))
+    );
+    // The sphere: radius 2, tessellated, with the material in effect.
+    let sphere = &scene.objects[6];
+    assert!(sphere.mesh.positions.iter().all(|p| (p.length() - 2.0).abs() < 1e-5));
+    assert_eq!(sphere.material, scene.objects[5].material);
+}
+
+/// Loads `text` as `name` and asserts a refusal naming `FILE:LINE:COLUMN` and `needle`.
+fn refused(d: &Path, name: &str, text: &str, line_col: &str, needle: &str) {
+    let path = write(d, name, text);
+    let err = pbrt::load(&path).expect_err(name);
+    assert_eq!(err.exit_code(), 2);
+    let msg = err.to_string();
+    let at = format!("{}:{line_col}: ", path.display());
+    assert!(msg.starts_with(&at), "{name}: {msg:?} does not start with {at:?}");
+    assert!(msg.contains(needle), "{name}: {msg:?} lacks {needle:?}");
+}
+
+#[test]
+fn every_refusal_names_file_line_and_column() {
+    let d = dir("refusals");
+    for (name, text, at, needle) in [
+        ("directive.pbrt", "WorldBegin\n  Frobnicate 1", "2:3", "unknown or unsupported directive 'Frobnicate'"),
+        ("object.pbrt", "ObjectBegin \"a\"", "1:1", "supported: LookAt"),
+        ("string.pbrt", "Shape \"sphere", "1:7", "never closed"),
+        ("number.pbrt", "Translate 1 2 x3", "1:1", "Translate takes 3 numbers"),
+        ("camera.pbrt", "Camera \"orthographic\"", "1:1", "only \"perspective\""),
+        ("material.pbrt", "Material \"conductor\"", "1:1", "subsurface, diffuse"),
+        ("shape.pbrt", "Shape \"cylinder\"", "1:1", "trianglemesh, plymesh, sphere"),
+        ("light.pbrt", "LightSource \"goniometric\"", "1:1", "distant, point, spot, infinite"),
+        ("texture.pbrt", "Texture \"t\" \"spectrum\" \"marble\"", "1:1", "constant, checkerboard, imagemap"),
+        ("type.pbrt", "Camera \"perspective\" \"integer fov\" 30", "1:22", "expected 'float'"),
+        (
+            "count.pbrt",
+            "LookAt 0 0 0 0 0 1 0 1 0\nShape \"trianglemesh\" \"point3 P\" [0 0 0 1]",
+            "2:22",
+            "multiple of 3",
+        ),
+        (
+            "indices.pbrt",
+            "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0 1 1 1] \"integer indices\" [0 1 9]",
+            "1:1",
+            "index 9 is out of range",
+        ),
+        ("ptype.pbrt", "Shape \"sphere\" \"quaternion q\" [1]", "1:16", "unknown parameter type"),
+        ("named.pbrt", "Material \"subsurface\" \"string name\" \"Unobtainium\"", "1:1", "no measured medium"),
+        ("half.pbrt", "Material \"subsurface\" \"rgb sigma_a\" [1 1 1]", "1:1", "without \"sigma_s\""),
+        ("nested.pbrt", "AttributeEnd", "1:1", "without a matching begin"),
+        ("open.pbrt", "AttributeBegin\nWorldBegin", "1:1", "AttributeBegin without AttributeEnd"),
+        ("include.pbrt", "Include \"missing.pbrt\"", "1:1", "cannot read"),
+        ("self.pbrt", "Include \"self.pbrt\"", "1:1", "nested deeper than 16"),
+        ("partial-sphere.pbrt", "Shape \"sphere\" \"float zmax\" 0.5", "1:1", "whole spheres"),
+        ("blackbody.pbrt", "LightSource \"point\" \"blackbody I\" [6500]", "1:21", "blackbody"),
+        ("plyname.pbrt", "Shape \"plymesh\" \"string filename\" \"a.obj\"", "1:1", "not a .ply"),
+        ("badply.pbrt", "Shape \"plymesh\" \"string filename\" \"bad.ply\"", "1:1", "line 1: not a PLY file"),
+        ("texref.pbrt", "Material \"diffuse\" \"texture reflectance\" \"nope\"", "1:20", "no texture named"),
+        ("stray.pbrt", "WorldBegin\n\"float x\" 1", "2:1", "expected a directive"),
+    ] {
+        if name == "badply.pbrt" {
+            write(&d, "bad.ply", "solid\n");
+        }
+        refused(&d, name, text, at, needle);
+    }
+    // Sizes: a huge index count costs what its tokens cost, and a file past the limit is refused unread.
+    let big = d.join("big.pbrt");
+    std::fs::File::create(&big).unwrap().set_len(pbrt::scene::MAX_SCENE_BYTES + 1).unwrap();
+    assert!(pbrt::load(&big).unwrap_err().to_string().contains("larger than the limit"));
+}
+
+fn render(args: &[&str]) -> std::process::Output {
+    let mut full = vec!["render"];
+    full.extend_from_slice(args);
+    common::translucent(&full)
+}
+
+/// The mean brightness of the left and right halves of an 8-bit image.
+fn halves(path: &Path) -> (f64, f64) {
+    let img = image::open(path).unwrap().into_rgb8();
+    let (w, _) = img.dimensions();
+    let (mut l, mut r) = (0.0, 0.0);
+    for (x, _, p) in img.enumerate_pixels() {
+        let v = p.0.iter().map(|&c| c as f64).sum::<f64>();
+        if x < w / 2 {
+            l += v;
+        } else {
+            r += v;
+        }
+    }
+    (l, r)
+}
+
+#[test]
+fn scenes_render_with_pbrts_handedness_and_flags_override() {
+    let d = dir("render");
+    let scene = |pre: &str, x: f64| {
+        format!(
+            "{pre}LookAt 0 0 -6  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 30\nFilm \"rgb\" \"integer xresolution\" 48 \"integer yresolution\" 32 \"string filename\" \"{}\"\n\
+             Sampler \"halton\"\nWorldBegin\nLightSource \"distant\" \"point3 from\" [0 0 -1] \"point3 to\" [0 0 0] \"rgb L\" [3 3 3]\n\
+             AttributeBegin\nTranslate {x} 0 0\nMaterial \"subsurface\" \"string name\" \"Skin1\" \"float scale\" 10\nShape \"sphere\" \"float radius\" 0.6\nAttributeEnd\n",
+            d.join("film.png").display()
+        )
+    };
+    // pbrt's camera is left-handed: +x is on the image's right; `Scale -1 1 1` first mirrors it.
+    for (pre, right) in [("", true), ("Scale -1 1 1\n", false)] {
+        let path = write(&d, "s.pbrt", &scene(pre, 1.0));
+        let out = render(&[path.to_str().unwrap(), "--samples", "4096"]);
+        assert_eq!(out.status.code(), Some(0), "{}", common::stderr(&out));
+        let err = common::stderr(&out);
+        assert_eq!(err.matches("Sampler is ignored").count(), 1, "{err}");
+        let img = image::open(d.join("film.png")).unwrap();
+        assert_eq!((img.width(), img.height()), (48, 32), "the film's size");
+        let (l, r) = halves(&d.join("film.png"));
+        assert_eq!(r > l, right, "pre {pre:?}: left {l} right {r}");
+    }
+    // Flags override the film.
+    let path = write(&d, "s.pbrt", &scene("", 0.0));
+    let out_png = d.join("flag.png");
+    let out = render(&[
+        path.to_str().unwrap(),
+        "--width",
+        "20",
+        "--height",
+        "24",
+        "--out",
+        out_png.to_str().unwrap(),
+        "--samples",
+        "4096",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", common::stderr(&out));
+    let img = image::open(&out_png).unwrap();
+    assert_eq!((img.width(), img.height()), (20, 24));
+    // What is not rendered yet is refused, naming the line.
+    let opaque = write(&d, "opaque.pbrt", &(scene("", 0.0) + "Shape \"sphere\"\n"));
+    let out = render(&[opaque.to_str().unwrap()]);
+    let err = common::stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("opaque.pbrt:12:1: ") && err.contains("not rendered yet"), "{err}");
+    let spot = write(&d, "spot.pbrt", &(scene("", 0.0) + "LightSource \"spot\"\n"));
+    let err = common::stderr(&render(&[spot.to_str().unwrap()]));
+    assert!(err.contains("spot.pbrt:12:1: ") && err.contains("spot lights are not rendered yet"), "{err}");
+    let bad = write(&d, "bad.pbrt", "WorldBegin\nShape \"cone\"\n");
+    let out = render(&[bad.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(common::stderr(&out).starts_with(&format!("error: {}:2:1: Shape \"cone\"", bad.display())));
+}
