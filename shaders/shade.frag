@@ -140,6 +140,8 @@ void main() {
         radiance = vec4(0.0);
         return;
     }
+    // Another object's pixel: its own draw shades it.
+    if (surface.w != float(pc.point_range.z + 1u)) discard;
     vec3 xo = surface.xyz;
     vec3 no = normalize(imageLoad(surface_normal, pixel).xyz);
     dipole_header = dipole_table_header(dipole_table);

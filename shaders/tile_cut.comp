@@ -29,6 +29,8 @@ layout(push_constant) uniform TileCutConstants {
     uvec2 pixels;     // image width and height
     uint capacity;    // entries the list buffer holds
     uint light_count;
+    uint object;      // the object whose pixels and tree these lists are of
+    uint pad;
 } pc;
 
 const uint END = 0xffffffffu;
@@ -116,7 +118,7 @@ void main() {
             ivec2 p = origin + ivec2(x, y);
             if (p.x >= int(pc.pixels.x) || p.y >= int(pc.pixels.y)) continue;
             vec4 s = imageLoad(surface_position, p);
-            if (s.w == 0.0) continue;
+            if (s.w != float(pc.object + 1u)) continue;
             lo = min(lo, s.xyz);
             hi = max(hi, s.xyz);
             covered = true;

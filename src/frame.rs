@@ -33,8 +33,9 @@ pub use crate::batching::DEFAULT_TILE;
 /// The shading inputs of object `o`, borrowed field by field (a method would borrow all of the
 /// renderer, and the profiler is borrowed mutably beside them).
 macro_rules! shade_inputs {
-    ($r:expr, $o:expr) => {{
-        let (o, t): (&GpuObject, &Targets) = ($o, &$r.targets);
+    ($r:expr, $k:expr) => {{
+        let (o, t, lists): (&GpuObject, &Targets, &TileLists) =
+            (&$r.world.objects[$k], &$r.targets, &$r.tile_lists[$k]);
         ShadeInputs {
             color: &t.color,
             depth: &t.depth,
@@ -53,21 +54,22 @@ macro_rules! shade_inputs {
             shadow_sampler: &o.hierarchy.shadow_sampler,
             point_lights: &o.hierarchy.sorted_point_lights,
             node_lights: &o.hierarchy.node_lights,
-            tile_headers: &$r.tile_lists.headers,
-            tile_entries: &$r.tile_lists.entries,
+            tile_headers: &lists.headers,
+            tile_entries: &lists.entries,
             dipole_table: &o.dipole_table,
         }
     }};
 }
 
-/// Records the tile-cut pass of object `o` (a macro for the same reason as `shade_inputs`).
+/// Records the tile-cut pass of object `k` (a macro for the same reason as `shade_inputs`).
 macro_rules! record_tile_cut {
-    ($r:expr, $o:expr, $rec:expr) => {{
-        let (o, lists): (&GpuObject, _) = ($o, &$r.tile_lists);
+    ($r:expr, $k:expr, $rec:expr) => {{
+        let (o, lists): (&GpuObject, &TileLists) = (&$r.world.objects[$k], &$r.tile_lists[$k]);
         let h = &o.hierarchy;
         let position = &$r.targets.position;
         let params = (&o.params, &$r.frame_params);
-        $r.passes.tile_cut.record($rec, params, &h.nodes, &h.sorted_points, position, lists, h.light_count)
+        let object = $k as u32;
+        $r.passes.tile_cut.record($rec, params, &h.nodes, &h.sorted_points, position, lists, h.light_count, object)
     }};
 }
 
@@ -113,8 +115,9 @@ pub struct Renderer {
     /// Nodes and points per pixel, counted on the GPU when profiling.
     work_counters: Buffer,
     passes: Passes,
-    /// The per-tile source lists, sized for the frame and grown when a frame needs more.
-    tile_lists: TileLists,
+    /// Per object, the per-tile source lists, sized for the frame and grown when a frame needs
+    /// more.
+    tile_lists: Vec<TileLists>,
     /// The most entries the lists may hold, when set lower than the device allows (tests).
     tile_list_limit: Option<u64>,
     /// Tile size and units per shading submission, learnt from the frames before.
@@ -175,7 +178,7 @@ impl Renderer {
             frame_params,
             work_counters,
             passes: Passes::new(&ctx)?,
-            tile_lists: TileLists::new(&ctx, 1, 1, None, None)?,
+            tile_lists: Vec::new(),
             tile_list_limit: None,
             batching: ShadeBatching::default(),
             generation: 0,
@@ -200,14 +203,18 @@ impl Renderer {
     pub fn set_tile_lists(&mut self, capacity: u64, limit: Option<u64>) -> Result<()> {
         self.ctx.wait_idle()?;
         let Extent2D { width, height } = self.targets.extent;
-        self.tile_lists = TileLists::new(&self.ctx, width, height, Some(capacity), limit)?;
+        for lists in &mut self.tile_lists {
+            *lists = TileLists::new(&self.ctx, width, height, Some(capacity), limit)?;
+        }
         self.tile_list_limit = limit;
         Ok(())
     }
 
-    /// Entries the last frame's tile lists asked for, and the entries they hold.
+    /// Entries the last frame's tile lists of the first object asked for, and the entries they
+    /// hold.
     pub fn tile_list_entries(&self) -> Result<(u64, u64)> {
-        Ok((self.tile_lists.entries_needed()?, self.tile_lists.capacity))
+        let lists = self.tile_lists.first().ok_or_else(|| crate::runtime!("no frame has been rendered"))?;
+        Ok((lists.entries_needed()?, lists.capacity))
     }
 
     /// The size of the images rendered.
@@ -231,11 +238,18 @@ impl Renderer {
         &self.targets.ldr
     }
 
+    /// Each object's shading units, object after object.
     fn units(&self, desc: &FrameDesc) -> Vec<shade::ShadeUnit> {
-        // Brute force sums (point, light) records, in ranges.
-        let records = |o: &GpuObject| o.hierarchy.point_count * o.hierarchy.light_count;
-        let brute_force_points = desc.integration.brute_force.then(|| self.world.objects.iter().map(records).sum());
-        self.batching.units(desc.width, desc.height, brute_force_points)
+        let mut units = Vec::new();
+        for (k, o) in self.world.objects.iter().enumerate() {
+            // Brute force sums (point, light) records, in ranges.
+            let records = o.hierarchy.point_count * o.hierarchy.light_count;
+            let brute_force_points = desc.integration.brute_force.then_some(records);
+            let first = units.len();
+            units.extend(self.batching.units(desc.width, desc.height, brute_force_points));
+            units[first..].iter_mut().for_each(|u| u.object = k as u32);
+        }
+        units
     }
 
     /// Shades in tiles of `tile` pixels square from the next frame on, always. How the shading is
@@ -328,7 +342,7 @@ impl Renderer {
         // A window's copy of the last image may still be reading these targets.
         self.ctx.wait_idle()?;
         self.targets = Targets::new(&self.ctx, extent)?;
-        self.tile_lists = TileLists::new(&self.ctx, width, height, None, self.tile_list_limit)?;
+        self.tile_lists.clear();
         // Learn again whether a frame of this size fits one submission.
         self.batching.relearn();
         Ok(())
@@ -382,19 +396,30 @@ impl HierarchyPasses {
         })
     }
 
-    /// The frame's first seven passes: `h` rebuilt from the mesh in `vertices` and `indices`.
-    /// Tests and tools record them alone to build a hierarchy.
+    /// The frame's first seven passes: `h` rebuilt from the mesh in `vertices` and `indices`,
+    /// alone in the world. Tests and tools record them so to build a hierarchy.
     pub fn record(&self, rec: &mut Recorder, h: &Hierarchy, vertices: &Buffer, indices: &Buffer) -> Result<()> {
+        self.record_among(rec, h, vertices, indices, &[(vertices, indices, h.index_count)])
+    }
+
+    /// The same among other objects: `casters` (every object's mesh, this one's included) cast
+    /// the shadows its irradiance sees.
+    pub fn record_among(
+        &self,
+        rec: &mut Recorder,
+        h: &Hierarchy,
+        vertices: &Buffer,
+        indices: &Buffer,
+        casters: &[(&Buffer, &Buffer, u32)],
+    ) -> Result<()> {
         let n = h.point_count;
         let (sort, tree) = (h.sort_buffers(), h.tree_buffers());
         // N points uniform by area over the mesh.
         rec.scope("sampling", |rec| {
             self.sampling.record(rec, vertices, indices, h.triangle_count, &h.prefix, &h.points, n, h.seed)
         })?;
-        // Depth from each light, into the layers of one shadow map.
-        rec.scope("shadow maps", |rec| {
-            self.shadow.record(rec, vertices, indices, h.index_count, &h.shadow_map, &h.layer_matrices)
-        })?;
+        // Depth of every object from each light, into the layers of one shadow map.
+        rec.scope("shadow maps", |rec| self.shadow.record(rec, casters, &h.shadow_map, &h.layer_matrices))?;
         // Per point and light: the light entering the surface, and its direction.
         rec.scope("irradiance", |rec| {
             let (points, records, lights) = (&h.points, &h.point_lights, &h.lights);
@@ -431,6 +456,12 @@ impl Renderer {
         world.validate()?;
         self.world.sync(&self.ctx, world, desc)?;
         self.fit_targets(desc.width, desc.height)?;
+        // Tile lists for each object (made again with the targets, or for a new object).
+        self.tile_lists.truncate(self.world.objects.len());
+        while self.tile_lists.len() < self.world.objects.len() {
+            let limit = self.tile_list_limit;
+            self.tile_lists.push(TileLists::new(&self.ctx, desc.width, desc.height, None, limit)?);
+        }
         let desc = desc.clone();
         let integration = desc.integration;
         self.frame_params.write(
@@ -453,32 +484,43 @@ impl Renderer {
             self.passes.shade.prepare(&self.ctx, integration.model, integration.brute_force)?;
         }
         let cut = shading && !integration.brute_force;
-        let object = &self.world.objects[0];
-        let inputs = shade_inputs!(self, object);
+        let objects = self.world.objects.len();
+        let casters: Vec<_> = self.world.objects.iter().map(|o| (&o.vertices, &o.indices, o.index_count)).collect();
+        let inputs: Vec<ShadeInputs> = (0..objects).map(|k| shade_inputs!(self, k)).collect();
         if let Some(p) = self.profiler.as_mut() {
             p.begin_frame();
         }
         self.ctx.submit(self.profiler.as_mut(), |rec| {
-            // The hierarchy, rebuilt from the mesh: seven passes (listed in `HierarchyPasses::record`).
-            self.passes.hierarchy.record(rec, &object.hierarchy, &object.vertices, &object.indices)?;
-            // The depth pre-pass and the G-buffer (world position and normal per pixel).
-            rec.scope("surface", |rec| self.passes.shade.record_surface(rec, &inputs, &constants))?;
-            if cut {
-                // Per tile, the sources far enough for every pixel in it.
-                rec.scope("tile cut", |rec| record_tile_cut!(self, object, rec))
-            } else {
-                // Brute force reads no lists; still, nothing the shader may load is left undefined.
-                rec.fill_buffer(&self.tile_lists.headers, 0)
+            for o in &self.world.objects {
+                // Each object's hierarchy, rebuilt from its mesh: seven passes (listed in
+                // `HierarchyPasses::record`), its shadow maps seeing every object.
+                self.passes.hierarchy.record_among(rec, &o.hierarchy, &o.vertices, &o.indices, &casters)?;
             }
+            // The depth pre-pass and the G-buffer (world position with the object, normal).
+            rec.scope("surface", |rec| self.passes.shade.record_surface(rec, &inputs, &constants))?;
+            for k in 0..objects {
+                if cut {
+                    // Per tile, the sources of this object far enough for every pixel of it.
+                    rec.scope("tile cut", |rec| record_tile_cut!(self, k, rec))?;
+                } else {
+                    // Brute force reads no lists; still, nothing the shader may load is left
+                    // undefined.
+                    rec.fill_buffer(&self.tile_lists[k].headers, 0)?;
+                }
+            }
+            Ok(())
         })?;
-        if cut {
-            if let Some(lists) = self.tile_lists.grown(&self.ctx)? {
+        drop(inputs);
+        for k in 0..objects {
+            if !cut {
+                break;
+            }
+            if let Some(lists) = self.tile_lists[k].grown(&self.ctx)? {
                 // Some tiles' lists did not fit (they would walk from the root): cut again into
                 // lists as big as this frame needs.
-                self.tile_lists = lists;
-                let object = &self.world.objects[0];
+                self.tile_lists[k] = lists;
                 self.ctx.submit(self.profiler.as_mut(), |rec| {
-                    rec.scope("tile cut", |rec| record_tile_cut!(self, object, rec))
+                    rec.scope("tile cut", |rec| record_tile_cut!(self, k, rec))
                 })?;
             }
         }
@@ -507,8 +549,7 @@ impl Renderer {
     /// would likely overrun it (at least one is made). Returns whether the shading is complete.
     pub fn shade_some(&mut self, frame: &mut FrameInProgress, budget: Option<std::time::Duration>) -> Result<bool> {
         self.check_current(frame)?;
-        let object = &self.world.objects[0];
-        let inputs = shade_inputs!(self, object);
+        let inputs: Vec<ShadeInputs> = (0..self.world.objects.len()).map(|k| shade_inputs!(self, k)).collect();
         let (constants, model) = (frame.constants, frame.desc.integration.model);
         let started = std::time::Instant::now();
         // Shading in several submissions, so that none runs long (see src/batching.rs).
@@ -521,9 +562,9 @@ impl Renderer {
             // The subsurface term and the specular lobe per pixel, a batch of tiles at a time.
             self.ctx.submit(self.profiler.as_mut(), |rec| {
                 rec.scope("shade", |rec| {
-                    batch
-                        .iter()
-                        .try_for_each(|unit| self.passes.shade.record_unit(rec, &inputs, &constants, unit, model))
+                    batch.iter().try_for_each(|unit| {
+                        self.passes.shade.record_unit(rec, &inputs[unit.object as usize], &constants, unit, model)
+                    })
                 })
             })?;
             let seconds = submitted.elapsed().as_secs_f64();

@@ -59,11 +59,10 @@ impl GpuWorld {
     /// new light records where only the lights moved; new parameters where the material, the
     /// diffusion or the scale changed. Both are validated by the caller.
     pub fn sync(&mut self, ctx: &Context, world: &World, desc: &FrameDesc) -> Result<()> {
-        if world.objects.len() > 1 {
-            return Err(bad_input!(
-                "{} objects: this renderer draws one translucent object per world so far",
-                world.objects.len()
-            ));
+        // Objects gone from the world take their GPU state with them.
+        if self.objects.len() > world.objects.len() {
+            ctx.wait_idle()?;
+            self.objects.truncate(world.objects.len());
         }
         let layout = |lights: &[Light]| (lights.len(), FrameSizes::shadow_layers(lights));
         let relayout = layout(&self.lights) != layout(&desc.lights) || self.shadow_resolution != desc.shadow_resolution;
@@ -81,7 +80,9 @@ impl GpuWorld {
                 }
                 (None, None) => {
                     let mesh = object.world_mesh();
-                    hierarchy::default_point_count(ctx, &mesh, world.mm_per_unit, &object.material, light_count)
+                    let m = &object.material;
+                    let share = world.objects.len() as u32;
+                    hierarchy::default_point_count(ctx, &mesh, world.mm_per_unit, m, light_count, share)
                 }
             });
         }
@@ -97,8 +98,11 @@ impl GpuWorld {
             },
         )?;
         let diffusion = desc.integration.diffusion;
+        let bounds: Vec<(Vec3, Vec3)> = world.objects.iter().map(|o| o.world_mesh().bounds()).collect();
         for (i, (object, &point_count)) in world.objects.iter().zip(&point_counts).enumerate() {
             let mesh = object.world_mesh();
+            // The other objects, whose shadows this one's maps must see.
+            let others = bounds.iter().enumerate().filter(|&(j, _)| j != i).map(|(_, b)| *b).reduce(union);
             let options = HierarchyOptions {
                 point_count,
                 shadow_resolution: desc.shadow_resolution,
@@ -112,7 +116,7 @@ impl GpuWorld {
                     mm_per_unit: world.mm_per_unit,
                     samples: object.samples,
                 };
-                self.objects.push(GpuObject::new(ctx, &desc.lights, &options, made_from)?);
+                self.objects.push(GpuObject::new(ctx, &desc.lights, &options, made_from, others)?);
                 continue;
             };
             let mesh_changed = *mesh != g.made_from.mesh;
@@ -127,15 +131,21 @@ impl GpuWorld {
                 g.bounds = mesh.bounds();
             }
             let eta_changed = object.material.eta != g.made_from.material.eta;
+            let casters_moved = others != g.hierarchy.casters();
+            g.hierarchy.set_casters(others);
             if remade {
                 g.hierarchy = Hierarchy::new(ctx, &mesh, &desc.lights, &options)?;
+                if others.is_some() {
+                    g.hierarchy.set_casters(others);
+                    g.hierarchy.set_lights(&mesh, &desc.lights)?;
+                }
             } else {
                 if eta_changed {
                     g.hierarchy.set_eta(options.eta)?;
                 }
                 if mesh_changed {
                     g.hierarchy.set_mesh(ctx, &mesh, &desc.lights)?;
-                } else if desc.lights != self.lights {
+                } else if desc.lights != self.lights || casters_moved {
                     g.hierarchy.set_lights(&mesh, &desc.lights)?;
                 }
             }
@@ -160,18 +170,30 @@ impl GpuWorld {
 
     /// The box around every object.
     pub fn bounds(&self) -> (Vec3, Vec3) {
-        self.objects
-            .iter()
-            .map(|o| o.bounds)
-            .fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), (a, b)| (lo.min(a), hi.max(b)))
+        self.objects.iter().map(|o| o.bounds).reduce(union).unwrap_or((Vec3::ZERO, Vec3::ZERO))
     }
 }
 
+/// The box around two boxes.
+fn union(a: (Vec3, Vec3), b: (Vec3, Vec3)) -> (Vec3, Vec3) {
+    (a.0.min(b.0), a.1.max(b.1))
+}
+
 impl GpuObject {
-    fn new(ctx: &Context, lights: &[Light], options: &HierarchyOptions, made_from: MadeFrom) -> Result<GpuObject> {
+    fn new(
+        ctx: &Context,
+        lights: &[Light],
+        options: &HierarchyOptions,
+        made_from: MadeFrom,
+        casters: Option<(Vec3, Vec3)>,
+    ) -> Result<GpuObject> {
         let mesh = &made_from.mesh;
         let (vertices, indices, index_count) = upload_mesh(ctx, mesh)?;
-        let hierarchy = Hierarchy::new(ctx, mesh, lights, options)?;
+        let mut hierarchy = Hierarchy::new(ctx, mesh, lights, options)?;
+        if casters.is_some() {
+            hierarchy.set_casters(casters);
+            hierarchy.set_lights(mesh, lights)?;
+        }
         let mut params = Buffer::new(
             ctx,
             "object parameters",

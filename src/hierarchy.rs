@@ -133,6 +133,8 @@ pub struct Hierarchy {
     pub shadow_map: Image,
     pub shadow_sampler: Sampler,
     pub(crate) layer_matrices: Vec<Mat4>,
+    /// The box of the other objects that may cast shadows on this one (see `set_casters`).
+    casters: Option<(Vec3, Vec3)>,
     eta: f32,
     shadow_resolution: u32,
     pub point_count: u32,
@@ -201,6 +203,7 @@ impl Hierarchy {
             )?,
             shadow_sampler: Sampler::new(ctx, true, true)?,
             layer_matrices: Vec::new(),
+            casters: None,
             eta: options.eta,
             shadow_resolution: res,
             point_count: n,
@@ -248,7 +251,7 @@ impl Hierarchy {
             };
             header.lights[k] =
                 GpuLight { position, intensity, first_layer: self.layer_matrices.len() as u32, pad: [0; 3] };
-            self.layer_matrices.extend(shadow::light_matrices(light, centre, radius));
+            self.layer_matrices.extend(shadow::light_matrices(light, centre, radius, self.casters));
         }
         if self.layer_matrices.len() as u32 > self.shadow_map.layers {
             return Err(runtime!(
@@ -260,6 +263,16 @@ impl Hierarchy {
         self.lights.write(0, &[header])?;
         self.lights.write(std::mem::size_of::<LightSetHeader>() as u64, &self.layer_matrices)?;
         Ok(())
+    }
+
+    /// The box of the world's other objects (`None`: this one is alone), whose shadows the maps
+    /// must see; takes effect with the next `set_lights`.
+    pub fn set_casters(&mut self, casters: Option<(Vec3, Vec3)>) {
+        self.casters = casters;
+    }
+
+    pub fn casters(&self) -> Option<(Vec3, Vec3)> {
+        self.casters
     }
 
     /// What the Morton and radix sort stages read and write.
@@ -498,9 +511,17 @@ pub fn choose_point_count(surface_area: f32, shortest_length: f32, budget: u32) 
 }
 
 /// Sample count from the material's shortest length scale (mean free path 1/σ't or diffusion
-/// length 1/σtr) and the mesh's area (in mm), within the device's budget for `lights` lights;
-/// prints the choice and warns when points are farther apart than that length.
-pub fn default_point_count(ctx: &Context, mesh: &Mesh, mm_per_unit: f32, material: &Material, lights: u32) -> u32 {
+/// length 1/σtr) and the mesh's area (in mm), within the device's budget for `lights` lights
+/// shared by `objects` objects; prints the choice and warns when points are farther apart than
+/// that length.
+pub fn default_point_count(
+    ctx: &Context,
+    mesh: &Mesh,
+    mm_per_unit: f32,
+    material: &Material,
+    lights: u32,
+    objects: u32,
+) -> u32 {
     let mm = mm_per_unit;
     let area_mm2 = mesh.surface_area() * mm * mm;
     let shortest = (0..3)
@@ -508,7 +529,7 @@ pub fn default_point_count(ctx: &Context, mesh: &Mesh, mm_per_unit: f32, materia
         .filter(|c| c.transports && c.sigma_tr > 0.0)
         .map(|c| (1.0 / c.sigma_tr).min(1.0 / c.sigma_t_reduced))
         .fold(f64::INFINITY, f64::min) as f32;
-    let budget = max_points(ctx, lights).min(1 << 18);
+    let budget = (max_points(ctx, lights).min(1 << 18) / objects.max(1)).max(4096);
     let (n, spacing) = choose_point_count(area_mm2, shortest, budget);
     crate::note!(
         "samples: {n} points, {spacing:.3} mm apart on {area_mm2:.0} mm² (shortest of mean free path and diffusion length: {shortest:.3} mm)"

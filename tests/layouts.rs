@@ -185,6 +185,7 @@ fn push_constants_match_glsl() {
         offset_of!(TileCutConstants, pixels),
         offset_of!(TileCutConstants, capacity),
         offset_of!(TileCutConstants, light_count),
+        offset_of!(TileCutConstants, object),
     ];
     assert_eq!(offsets("tile_cut.comp", "TileCutConstants"), cut.map(|o| o as u32));
     let debug = [offset_of!(DebugConstants, view_projection), offset_of!(DebugConstants, color_scale)];

@@ -119,4 +119,7 @@ pub struct TileCutConstants {
     /// Entries the list buffer holds.
     pub capacity: u32,
     pub light_count: u32,
+    /// The object whose pixels (G-buffer position w = object + 1) and tree the lists are of.
+    pub object: u32,
+    pub pad: u32,
 }

@@ -63,6 +63,8 @@ pub struct ShadeUnit {
     pub height: u32,
     pub first_point: u32,
     pub point_count: u32,
+    /// The object shaded (its pixels; others are left as they are).
+    pub object: u32,
 }
 
 /// Tiles of `tile` pixels over `width` x `height`, each repeated for every range of
@@ -77,7 +79,7 @@ pub fn shade_units(width: u32, height: u32, tile: u32, brute_force_points: Optio
         for x in (0..width).step_by(tile as usize) {
             for &(first_point, point_count) in &ranges {
                 let (w, h) = (tile.min(width - x), tile.min(height - y));
-                units.push(ShadeUnit { x, y, width: w, height: h, first_point, point_count });
+                units.push(ShadeUnit { x, y, width: w, height: h, first_point, point_count, object: 0 });
             }
         }
     }
@@ -148,15 +150,30 @@ impl ShadePass {
         Ok(())
     }
 
-    /// Clears the colour target and the work counters and rasterises the mesh into the G-buffer.
-    pub fn record_surface(&self, rec: &mut Recorder, inputs: &ShadeInputs, constants: &ShadeConstants) -> Result<()> {
+    /// Clears the colour target and the work counters and rasterises every object's mesh into
+    /// the G-buffer (its position's w is the object's index + 1).
+    pub fn record_surface(
+        &self,
+        rec: &mut Recorder,
+        objects: &[ShadeInputs],
+        constants: &ShadeConstants,
+    ) -> Result<()> {
+        let inputs = objects.first().ok_or_else(|| crate::runtime!("surface: no objects"))?;
         rec.fill_buffer(inputs.work, 0)?;
         rec.begin_rendering(&[(inputs.color, Some([0.0; 4]))], None, 0)?;
         rec.end_rendering();
+        for o in objects {
+            rec.use_buffer(o.vertices, vk::Access::VERTEX_INPUT)?;
+            rec.use_buffer(o.indices, vk::Access::INDEX_INPUT)?;
+        }
         let targets = [(inputs.position, Some([0.0; 4])), (inputs.normal, Some([0.0; 4]))];
         rec.begin_rendering(&targets, Some((inputs.depth, Some(1.0))), 0)?;
-        let (v, i) = (Some(inputs.vertices), Some(inputs.indices));
-        rec.draw(&self.surface, &[], vk::bytes_of(constants), v, i, inputs.index_count, 1)?;
+        for (k, o) in objects.iter().enumerate() {
+            let mut c = *constants;
+            c.point_range.z = k as u32;
+            let (v, i) = (Some(o.vertices), Some(o.indices));
+            rec.draw(&self.surface, &[], vk::bytes_of(&c), v, i, o.index_count, 1)?;
+        }
         rec.end_rendering();
         Ok(())
     }
@@ -189,7 +206,7 @@ impl ShadePass {
             Bind::Uniform(inputs.frame_params),
         ];
         let mut c = *constants;
-        c.point_range = glam::UVec4::new(unit.first_point, unit.point_count, 0, 0);
+        c.point_range = glam::UVec4::new(unit.first_point, unit.point_count, unit.object, 0);
         let additive = unit.point_count > 0;
         let pipeline = self
             .shading

@@ -1,6 +1,6 @@
-//! Shadow maps: the mesh's depth seen from each light, one layer of a 2D-array depth image per
-//! directional light and six (+x −x +y −y +z −z) per point light.
-//! Reads: vertices, indices. Writes: the shadow map.
+//! Shadow maps: the depth of every object seen from each light, one layer of a 2D-array depth
+//! image per directional light and six (+x −x +y −y +z −z) per point light, fitted to the object
+//! that receives the shadows. Reads: every object's vertices and indices. Writes: the shadow map.
 
 use glam::{Mat4, Vec3};
 
@@ -12,19 +12,46 @@ use crate::vk::{
 
 pub const SHADOW_FORMAT: Format = Format::D32_SFLOAT;
 
-/// The light's view-projection matrices (one per layer) for a scene in the sphere (centre, radius).
-pub fn light_matrices(light: &Light, centre: Vec3, radius: f32) -> Vec<Mat4> {
+/// The light's view-projection matrices (one per layer) for a receiver in the sphere (centre,
+/// radius), with the box of the other objects that may cast shadows on it (`casters`). The maps
+/// cover the receiver's sphere; their depth range reaches toward the light as far as casters lie
+/// in front of the receiver, and no farther, so that a receiver alone, or beside objects that are
+/// not between it and the light, gets the same maps as before.
+pub fn light_matrices(light: &Light, centre: Vec3, radius: f32, casters: Option<(Vec3, Vec3)>) -> Vec<Mat4> {
+    let corners = |(lo, hi): (Vec3, Vec3)| {
+        (0..8).map(move |i| Vec3::new([lo.x, hi.x][i & 1], [lo.y, hi.y][(i >> 1) & 1], [lo.z, hi.z][i >> 2]))
+    };
     match *light {
         Light::Directional { toward, .. } => {
             let d = toward.normalize();
             let up = if d.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
+            // How far casters over the receiver's footprint rise toward the light beyond its sphere.
             let view = Mat4::look_at_rh(centre + d * 2.0 * radius, centre, up);
-            vec![Mat4::orthographic_rh(-radius, radius, -radius, radius, 0.5 * radius, 3.5 * radius) * view]
+            let extra = casters.map_or(0.0, |b| {
+                let (lo, hi) = corners(b)
+                    .map(|p| view.transform_point3(p))
+                    .fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), p| (lo.min(p), hi.max(p)));
+                let over = lo.x < radius && hi.x > -radius && lo.y < radius && hi.y > -radius;
+                // View space looks down −z from 2r above the centre: z = −r is the sphere's top.
+                if over {
+                    (hi.z + radius).max(0.0)
+                } else {
+                    0.0
+                }
+            });
+            let view = Mat4::look_at_rh(centre + d * (2.0 * radius + extra), centre, up);
+            let (near, far) = (0.5 * radius, 3.5 * radius + extra);
+            vec![Mat4::orthographic_rh(-radius, radius, -radius, radius, near, far) * view]
         }
         Light::Point { position, .. } => {
             let distance = (position - centre).length();
             let far = distance + radius * 1.01;
-            let near = (distance - radius * 1.01).max(far * 1e-4);
+            let mut near = distance - radius * 1.01;
+            if let Some((lo, hi)) = casters {
+                // The casters' nearest point to the light.
+                near = near.min((position.clamp(lo, hi) - position).length());
+            }
+            let near = near.max(far * 1e-4);
             let faces = [
                 (Vec3::X, Vec3::Y),
                 (Vec3::NEG_X, Vec3::Y),
@@ -71,21 +98,25 @@ impl ShadowPass {
         Ok(ShadowPass { pipeline })
     }
 
+    /// Every mesh of `casters` (vertices, indices, index count) into each layer of `shadow_map`.
     pub fn record(
         &self,
         rec: &mut Recorder,
-        vertices: &Buffer,
-        indices: &Buffer,
-        index_count: u32,
+        casters: &[(&Buffer, &Buffer, u32)],
         shadow_map: &Image,
         matrices: &[Mat4],
     ) -> Result<()> {
         for (layer, matrix) in matrices.iter().enumerate() {
-            rec.use_buffer(vertices, vk::Access::VERTEX_INPUT)?;
-            rec.use_buffer(indices, vk::Access::INDEX_INPUT)?;
+            for &(vertices, indices, _) in casters {
+                rec.use_buffer(vertices, vk::Access::VERTEX_INPUT)?;
+                rec.use_buffer(indices, vk::Access::INDEX_INPUT)?;
+            }
             rec.begin_rendering(&[], Some((shadow_map, Some(1.0))), layer as u32)?;
             rec.set_depth_bias(0.0, 1.5);
-            rec.draw(&self.pipeline, &[], bytemuck::bytes_of(matrix), Some(vertices), Some(indices), index_count, 1)?;
+            for &(vertices, indices, count) in casters {
+                let matrix = bytemuck::bytes_of(matrix);
+                rec.draw(&self.pipeline, &[], matrix, Some(vertices), Some(indices), count, 1)?;
+            }
             rec.end_rendering();
         }
         Ok(())

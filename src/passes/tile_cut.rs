@@ -104,6 +104,7 @@ impl TileCutPass {
         position: &Image,
         lists: &TileLists,
         light_count: u32,
+        object: u32,
     ) -> Result<()> {
         rec.fill_buffer(&lists.allocation, 0)?;
         let constants = TileCutConstants {
@@ -111,6 +112,8 @@ impl TileCutPass {
             pixels: lists.pixels,
             capacity: lists.capacity.min(u32::MAX as u64) as u32,
             light_count,
+            object,
+            pad: 0,
         };
         rec.dispatch(
             &self.pipeline,

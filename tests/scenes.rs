@@ -1,0 +1,88 @@
+//! Worlds of several objects: each translucent object has its own material, points and tree, and
+//! light does not scatter from one into another (validation on).
+
+mod common;
+
+use glam::{Mat4, Vec3};
+use translucent::frame::Renderer;
+use translucent::frame_desc::FrameDesc;
+use translucent::materials::Material;
+use translucent::mesh::Mesh;
+use translucent::output::HdrImage;
+use translucent::scene::{Camera, Light};
+use translucent::world::{Object, World};
+
+fn render(world: &World, desc: &FrameDesc) -> HdrImage {
+    let (ctx, counts) = common::validated_context();
+    let mut renderer = Renderer::new(ctx, false).expect("renderer");
+    renderer.render_frame(world, desc).expect("frame");
+    let image = renderer.image().expect("image");
+    drop(renderer);
+    common::assert_clean(&counts);
+    image
+}
+
+fn placed(mesh: Mesh, material: &str, at: Vec3, samples: u32) -> Object {
+    let mut o = Object::new(mesh, Material::find(material).unwrap());
+    o.transform = Mat4::from_translation(at);
+    o.samples = Some(samples);
+    o
+}
+
+/// A marble sphere and a skin torus side by side, lit from above (neither shadows the other):
+/// every pixel of each equals that object rendered alone, bit for bit, for the tree and for brute
+/// force, with the camera and lights unchanged.
+#[test]
+fn two_objects_side_by_side_equal_each_alone() {
+    let sphere = placed(Mesh::sphere(0.8, 24), "marble", Vec3::new(-1.1, 0.0, 0.0), 4096);
+    let torus = placed(Mesh::torus(0.6, 0.25, 32, 16), "skin1", Vec3::new(1.1, 0.0, 0.0), 3000);
+    let camera = Camera { eye: Vec3::new(0.0, 0.6, 5.0), target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 45.0 };
+    let light = Light::Directional { toward: Vec3::new(0.1, 1.0, 0.3).normalize(), irradiance: Vec3::ONE };
+    let mut desc = FrameDesc::new(camera, vec![light]);
+    (desc.width, desc.height, desc.shadow_resolution) = (96, 48, 512);
+    for brute_force in [false, true] {
+        desc.integration.brute_force = brute_force;
+        let both = render(&World { objects: vec![sphere.clone(), torus.clone()], mm_per_unit: 10.0 }, &desc);
+        let alone = [&sphere, &torus].map(|o| render(&World { objects: vec![o.clone()], mm_per_unit: 10.0 }, &desc));
+        let mut covered = [0usize; 2];
+        for (i, p) in both.pixels.iter().enumerate() {
+            let owners: Vec<usize> = (0..2).filter(|&k| alone[k].pixels[i][3] > 0.0).collect();
+            match owners.as_slice() {
+                [] => assert_eq!(p[3], 0.0, "pixel {i}: covered in the pair, by neither alone"),
+                [k] => {
+                    covered[*k] += 1;
+                    let q = alone[*k].pixels[i];
+                    assert!(
+                        p.map(f32::to_bits) == q.map(f32::to_bits),
+                        "brute force {brute_force}, object {k}, pixel {i}: {p:?} vs {q:?} alone"
+                    );
+                }
+                _ => panic!("pixel {i}: the objects overlap on screen; move them apart"),
+            }
+        }
+        assert!(covered[0] > 100 && covered[1] > 100, "both objects in view: {covered:?}");
+    }
+}
+
+/// An object in the light's way shadows the one behind it: a slab held above a sphere darkens it,
+/// and the sphere's own points see the slab in their shadow maps.
+#[test]
+fn an_object_between_the_light_and_another_shadows_it() {
+    let sphere = placed(Mesh::sphere(0.8, 24), "marble", Vec3::ZERO, 4096);
+    let slab = placed(Mesh::slab(3.0, 3.0, 0.2), "ketchup", Vec3::new(0.0, 1.6, 0.0), 4096);
+    let camera = Camera { eye: Vec3::new(0.0, 0.3, 5.0), target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 40.0 };
+    let light = Light::Directional { toward: Vec3::Y, irradiance: Vec3::ONE };
+    let mut desc = FrameDesc::new(camera, vec![light]);
+    (desc.width, desc.height, desc.specular) = (64, 64, false);
+    let alone = render(&World { objects: vec![sphere.clone()], mm_per_unit: 10.0 }, &desc);
+    let shaded = render(&World { objects: vec![sphere, slab], mm_per_unit: 10.0 }, &desc);
+    // The sphere's pixels: those below the slab's projection in the image (the lower half).
+    let mean = |img: &HdrImage| {
+        let rows = img.height / 2 + 8..img.height;
+        let px: Vec<_> = rows.flat_map(|y| (0..img.width).map(move |x| (y * img.width + x) as usize)).collect();
+        let lit: Vec<_> = px.iter().map(|&i| img.pixels[i]).filter(|p| p[3] > 0.0).collect();
+        lit.iter().map(|p| p[0] as f64).sum::<f64>() / lit.len().max(1) as f64
+    };
+    let (a, s) = (mean(&alone), mean(&shaded));
+    assert!(a > 0.0 && s < 0.2 * a, "the slab's shadow must darken the sphere: {s} vs {a} alone");
+}
