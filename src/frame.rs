@@ -49,9 +49,9 @@ macro_rules! shade_inputs {
             nodes: &o.hierarchy.nodes,
             points: &o.hierarchy.sorted_points,
             work: &$r.work_counters,
-            lights: &o.hierarchy.lights,
-            shadow_map: &o.hierarchy.shadow_map,
-            shadow_sampler: &o.hierarchy.shadow_sampler,
+            lights: &o.hierarchy.shadows.lights,
+            shadow_map: &o.hierarchy.shadows.shadow_map,
+            shadow_sampler: &o.hierarchy.shadows.shadow_sampler,
             point_lights: &o.hierarchy.sorted_point_lights,
             node_lights: &o.hierarchy.node_lights,
             tile_headers: &lists.headers,
@@ -419,11 +419,12 @@ impl HierarchyPasses {
             self.sampling.record(rec, vertices, indices, h.triangle_count, &h.prefix, &h.points, n, h.seed)
         })?;
         // Depth of every object from each light, into the layers of one shadow map.
-        rec.scope("shadow maps", |rec| self.shadow.record(rec, casters, &h.shadow_map, &h.layer_matrices))?;
+        let shadows = &h.shadows;
+        rec.scope("shadow maps", |rec| self.shadow.record(rec, casters, &shadows.shadow_map, &shadows.layer_matrices))?;
         // Per point and light: the light entering the surface, and its direction.
         rec.scope("irradiance", |rec| {
-            let (points, records, lights) = (&h.points, &h.point_lights, &h.lights);
-            self.irradiance.record(rec, points, records, n, lights, &h.shadow_map, &h.shadow_sampler)
+            let (points, records, lights) = (&h.points, &h.point_lights, &shadows.lights);
+            self.irradiance.record(rec, points, records, n, lights, &shadows.shadow_map, &shadows.shadow_sampler)
         })?;
         // A key per point along a Morton curve through the mesh's box.
         rec.scope("morton codes", |rec| self.sort.record_morton(rec, &sort, n, h.bounds()))?;

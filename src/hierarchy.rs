@@ -7,21 +7,19 @@
 //! contiguous range of the sorted array. Leaves are single points; the shading pass can stop
 //! descending at small ranges and loop over the points directly.
 
-use glam::{DVec3, Mat4, Vec3};
+use glam::{DVec3, Vec3};
 
 use crate::error::Result;
-use crate::gpu::{
-    GpuLight, LightSetHeader, NodeLight, PointLight, SurfacePoint, TreeNode, LEAF_BIT, MAX_LIGHTS, RADIX_TILE as TILE,
-};
+use crate::gpu::{NodeLight, PointLight, SurfacePoint, TreeNode, LEAF_BIT, MAX_LIGHTS, RADIX_TILE as TILE};
 use crate::materials::Material;
 use crate::mesh::Mesh;
 use crate::passes::sampling::prefix_bytes;
-use crate::passes::shadow;
 use crate::passes::sort::SortBuffers;
 use crate::passes::tree::TreeBuffers;
 use crate::physics::Diffusion;
 use crate::scene::Light;
-use crate::vk::{self, Buffer, BufferUsageFlags, Context, Extent2D, Image, ImageUsageFlags, MemoryLocation, Sampler};
+use crate::shadows::Shadows;
+use crate::vk::{self, Buffer, BufferUsageFlags, Context, MemoryLocation};
 use crate::{bad_input, runtime};
 
 impl TreeNode {
@@ -129,14 +127,8 @@ pub struct Hierarchy {
     pub node_parent: Buffer,
     pub point_parent: Buffer,
     pub arrivals: Buffer,
-    pub lights: Buffer,
-    pub shadow_map: Image,
-    pub shadow_sampler: Sampler,
-    pub(crate) layer_matrices: Vec<Mat4>,
-    /// The box of the other objects that may cast shadows on this one (see `set_casters`).
-    casters: Option<(Vec3, Vec3)>,
-    eta: f32,
-    shadow_resolution: u32,
+    /// The lights and the shadow maps fitted to this object (the irradiance pass reads them).
+    pub shadows: Shadows,
     pub point_count: u32,
     /// Lights the per-light records were made for (at creation; later light sets may not exceed it).
     pub light_count: u32,
@@ -168,7 +160,6 @@ impl Hierarchy {
         };
         let n64 = n as u64;
         let tiles = n.div_ceil(TILE) as u64;
-        let layers: u32 = lights.iter().map(|l| if matches!(l, Light::Point { .. }) { 6 } else { 1 }).sum();
         let res = options.shadow_resolution;
         let (lo, hi) = mesh.bounds();
         let pad = (hi - lo).max_element() * 1e-3;
@@ -186,26 +177,7 @@ impl Hierarchy {
             node_parent: storage("node parents", (n64 - 1) * 4)?,
             point_parent: storage("point parents", n64 * 4)?,
             arrivals: storage("node arrival counters", (n64 - 1) * 4)?,
-            lights: Buffer::new(
-                ctx,
-                "lights",
-                (std::mem::size_of::<LightSetHeader>() + 64 * layers as usize) as u64,
-                BufferUsageFlags::STORAGE_BUFFER,
-                MemoryLocation::CpuToGpu,
-            )?,
-            shadow_map: Image::new_2d(
-                ctx,
-                "shadow map",
-                shadow::SHADOW_FORMAT,
-                Extent2D { width: res, height: res },
-                layers.max(2), // an array view even for one light (sampler2DArrayShadow)
-                ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | ImageUsageFlags::SAMPLED,
-            )?,
-            shadow_sampler: Sampler::new(ctx, true, true)?,
-            layer_matrices: Vec::new(),
-            casters: None,
-            eta: options.eta,
-            shadow_resolution: res,
+            shadows: Shadows::new(ctx, lights, res, options.eta)?,
             point_count: n,
             light_count,
             triangle_count: mesh.triangle_count() as u32,
@@ -220,59 +192,31 @@ impl Hierarchy {
     /// Writes the lights and their shadow matrices (call when lights change, e.g. every frame).
     /// The number of shadow-map layers each light needs must stay what it was at creation.
     pub fn set_lights(&mut self, mesh: &Mesh, lights: &[Light]) -> Result<()> {
-        let (eta, resolution) = (self.eta, self.shadow_resolution);
         if lights.is_empty() || lights.len() > MAX_LIGHTS {
             return Err(bad_input!("between 1 and {MAX_LIGHTS} lights are supported, {} given", lights.len()));
         }
         if lights.len() != self.light_count as usize {
             return Err(runtime!("{} lights given, the hierarchy was made for {}", lights.len(), self.light_count));
         }
-        let (centre, radius) = crate::scene::bounding_sphere(&mesh.positions);
-        let radius = radius.max(1e-6) * 1.01;
-        let mut header = LightSetHeader {
-            light_count: lights.len() as u32,
-            eta,
-            // Two shadow-map texels of the orthographic maps.
-            normal_offset: 2.0 * 2.0 * radius / resolution as f32,
-            pad: 0.0,
-            lights: [GpuLight::default(); MAX_LIGHTS],
-        };
-        self.layer_matrices.clear();
-        for (k, light) in lights.iter().enumerate() {
-            light.validate()?;
+        for light in lights {
             if let Light::Point { position, .. } = light {
                 if mesh.contains_point(*position) {
                     return Err(bad_input!("point light at {position} is inside the mesh: it would light nothing"));
                 }
             }
-            let (position, intensity) = match *light {
-                Light::Directional { toward, irradiance } => (toward.normalize().extend(0.0), irradiance.extend(0.0)),
-                Light::Point { position, intensity } => (position.extend(1.0), intensity.extend(0.0)),
-            };
-            header.lights[k] =
-                GpuLight { position, intensity, first_layer: self.layer_matrices.len() as u32, pad: [0; 3] };
-            self.layer_matrices.extend(shadow::light_matrices(light, centre, radius, self.casters));
         }
-        if self.layer_matrices.len() as u32 > self.shadow_map.layers {
-            return Err(runtime!(
-                "lights need {} shadow layers, {} allocated",
-                self.layer_matrices.len(),
-                self.shadow_map.layers
-            ));
-        }
-        self.lights.write(0, &[header])?;
-        self.lights.write(std::mem::size_of::<LightSetHeader>() as u64, &self.layer_matrices)?;
-        Ok(())
+        let (centre, radius) = crate::scene::bounding_sphere(&mesh.positions);
+        self.shadows.set_lights(centre, radius, lights)
     }
 
     /// The box of the world's other objects (`None`: this one is alone), whose shadows the maps
     /// must see; takes effect with the next `set_lights`.
     pub fn set_casters(&mut self, casters: Option<(Vec3, Vec3)>) {
-        self.casters = casters;
+        self.shadows.set_casters(casters);
     }
 
     pub fn casters(&self) -> Option<(Vec3, Vec3)> {
-        self.casters
+        self.shadows.casters()
     }
 
     /// What the Morton and radix sort stages read and write.
@@ -323,14 +267,13 @@ impl Hierarchy {
     }
 
     pub fn eta(&self) -> f32 {
-        self.eta
+        self.shadows.eta()
     }
 
     /// The relative index of refraction used for the light entering the surface (a material
     /// change); written into the light set at once.
     pub fn set_eta(&mut self, eta: f32) -> Result<()> {
-        self.eta = eta;
-        self.lights.write(std::mem::offset_of!(LightSetHeader, eta) as u64, &[eta])
+        self.shadows.set_eta(eta)
     }
 
     /// Follows a mesh that changed (deformed, or the next of a sequence): its triangle count,

@@ -28,6 +28,7 @@ pub mod profiling;
 pub mod scene;
 pub mod settings;
 pub mod shaders;
+pub mod shadows;
 pub mod view;
 pub mod vk;
 pub mod world;

@@ -1,0 +1,118 @@
+//! A set of lights as the GPU reads it, with the shadow maps fitted to one receiver: the lights
+//! buffer (`LightSet` and each shadow layer's matrix, lights.glsl), the 2D-array shadow map and
+//! its comparison sampler. Each translucent object's hierarchy has one; opaque objects share one.
+
+use glam::{Mat4, Vec3};
+
+use crate::error::Result;
+use crate::gpu::{GpuLight, LightSetHeader, MAX_LIGHTS};
+use crate::passes::shadow;
+use crate::scene::Light;
+use crate::vk::{Buffer, BufferUsageFlags, Context, Extent2D, Image, ImageUsageFlags, MemoryLocation, Sampler};
+use crate::{bad_input, runtime};
+
+pub struct Shadows {
+    /// `LightSetHeader`, then one matrix per shadow-map layer.
+    pub lights: Buffer,
+    pub shadow_map: Image,
+    pub shadow_sampler: Sampler,
+    pub(crate) layer_matrices: Vec<Mat4>,
+    /// The box of the other objects that may cast shadows on the receiver (see `set_casters`).
+    casters: Option<(Vec3, Vec3)>,
+    eta: f32,
+    resolution: u32,
+    /// Lights the buffer and layers were made for (later light sets may not exceed it).
+    pub light_count: u32,
+}
+
+impl Shadows {
+    /// For `lights` at `resolution` texels per side (per cube face for point lights); `eta` is the
+    /// receiver's relative index (its Fresnel transmittance), 1 for an opaque receiver.
+    pub fn new(ctx: &Context, lights: &[Light], resolution: u32, eta: f32) -> Result<Shadows> {
+        if lights.is_empty() || lights.len() > MAX_LIGHTS {
+            return Err(bad_input!("between 1 and {MAX_LIGHTS} lights are supported, {} given", lights.len()));
+        }
+        let layers: u32 = lights.iter().map(|l| if matches!(l, Light::Point { .. }) { 6 } else { 1 }).sum();
+        Ok(Shadows {
+            lights: Buffer::new(
+                ctx,
+                "lights",
+                (std::mem::size_of::<LightSetHeader>() + 64 * layers as usize) as u64,
+                BufferUsageFlags::STORAGE_BUFFER,
+                MemoryLocation::CpuToGpu,
+            )?,
+            shadow_map: Image::new_2d(
+                ctx,
+                "shadow map",
+                shadow::SHADOW_FORMAT,
+                Extent2D { width: resolution, height: resolution },
+                layers.max(2), // an array view even for one light (sampler2DArrayShadow)
+                ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | ImageUsageFlags::SAMPLED,
+            )?,
+            shadow_sampler: Sampler::new(ctx, true, true)?,
+            layer_matrices: Vec::new(),
+            casters: None,
+            eta,
+            resolution,
+            light_count: lights.len() as u32,
+        })
+    }
+
+    /// Writes the lights and their shadow matrices for a receiver in the sphere (centre, radius).
+    /// The number of shadow-map layers each light needs must stay what it was at creation.
+    pub fn set_lights(&mut self, centre: Vec3, radius: f32, lights: &[Light]) -> Result<()> {
+        if lights.len() != self.light_count as usize {
+            return Err(runtime!("{} lights given, the shadow maps were made for {}", lights.len(), self.light_count));
+        }
+        let radius = radius.max(1e-6) * 1.01;
+        let mut header = LightSetHeader {
+            light_count: lights.len() as u32,
+            eta: self.eta,
+            // Two shadow-map texels of the orthographic maps.
+            normal_offset: 2.0 * 2.0 * radius / self.resolution as f32,
+            pad: 0.0,
+            lights: [GpuLight::default(); MAX_LIGHTS],
+        };
+        self.layer_matrices.clear();
+        for (k, light) in lights.iter().enumerate() {
+            light.validate()?;
+            let (position, intensity) = match *light {
+                Light::Directional { toward, irradiance } => (toward.normalize().extend(0.0), irradiance.extend(0.0)),
+                Light::Point { position, intensity } => (position.extend(1.0), intensity.extend(0.0)),
+            };
+            header.lights[k] =
+                GpuLight { position, intensity, first_layer: self.layer_matrices.len() as u32, pad: [0; 3] };
+            self.layer_matrices.extend(shadow::light_matrices(light, centre, radius, self.casters));
+        }
+        if self.layer_matrices.len() as u32 > self.shadow_map.layers {
+            return Err(runtime!(
+                "lights need {} shadow layers, {} allocated",
+                self.layer_matrices.len(),
+                self.shadow_map.layers
+            ));
+        }
+        self.lights.write(0, &[header])?;
+        self.lights.write(std::mem::size_of::<LightSetHeader>() as u64, &self.layer_matrices)?;
+        Ok(())
+    }
+
+    /// The box of the world's other objects (`None`: the receiver is alone), whose shadows the
+    /// maps must see; takes effect with the next `set_lights`.
+    pub fn set_casters(&mut self, casters: Option<(Vec3, Vec3)>) {
+        self.casters = casters;
+    }
+
+    pub fn casters(&self) -> Option<(Vec3, Vec3)> {
+        self.casters
+    }
+
+    pub fn eta(&self) -> f32 {
+        self.eta
+    }
+
+    /// The receiver's relative index of refraction (a material change); written at once.
+    pub fn set_eta(&mut self, eta: f32) -> Result<()> {
+        self.eta = eta;
+        self.lights.write(std::mem::offset_of!(LightSetHeader, eta) as u64, &[eta])
+    }
+}
