@@ -10,8 +10,11 @@ layout(location = 0) in vec3 world_position;
 layout(location = 1) in vec3 world_normal;
 layout(location = 0) out vec4 position;
 layout(location = 1) out vec4 normal;
+// The reflectance of opaque objects (surface_diffuse.frag); none here.
+layout(location = 2) out vec4 albedo;
 
 void main() {
     position = vec4(world_position, float(pc.point_range.z + 1u));
     normal = vec4(world_normal, 0.0);
+    albedo = vec4(0.0);
 }

@@ -88,9 +88,9 @@ pub fn check_frame(ctx: &Context, s: &FrameSizes) -> Result<()> {
     // Device memory: the frame's targets, the shadow maps and the hierarchy (host-visible
     // read-back buffers live in another heap on a discrete GPU and are left out).
     let parts = [
-        // Colour 16, depth 4, G-buffer 2 × 16, tile lists about 17 (a 16-byte header and 256
+        // Colour 16, depth 4, G-buffer 3 × 16, tile lists about 17 (a 16-byte header and 256
         // entries of 4 bytes per 8×8 tile) bytes per pixel.
-        (size, w as u64 * h as u64 * (16 + 4 + 2 * 16 + 17)),
+        (size, w as u64 * h as u64 * (16 + 4 + 3 * 16 + 17)),
         ("--shadow-resolution", res as u64 * res as u64 * s.shadow_layers as u64 * 4),
         ("--samples", crate::hierarchy::bytes_used(s.point_count, s.light_count)),
     ];

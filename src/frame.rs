@@ -14,14 +14,16 @@ use crate::gpu_world::{GpuObject, GpuWorld};
 use crate::hierarchy::Hierarchy;
 use crate::output::{self, Exposure, HdrImage};
 use crate::passes::debug_view::{self, DebugViewPass};
+use crate::passes::diffuse::DiffusePass;
 use crate::passes::irradiance::IrradiancePass;
 use crate::passes::sampling::SamplingPass;
-use crate::passes::shade::{self, ShadeInputs, ShadePass};
+use crate::passes::shade::{self, OpaqueDraw, ShadeInputs, ShadePass};
 use crate::passes::shadow::ShadowPass;
 use crate::passes::sort::SortPass;
 use crate::passes::tile_cut::{TileCutPass, TileLists};
 use crate::passes::tonemap::{self, TonemapPass};
 use crate::passes::tree::TreePass;
+use crate::shadows::Shadows;
 use crate::vk::{
     self, Buffer, BufferUsageFlags, Context, Extent2D, GpuProfiler, Image, ImageUsageFlags, MemoryLocation, Recorder,
     TimedScope,
@@ -41,6 +43,7 @@ macro_rules! shade_inputs {
             depth: &t.depth,
             position: &t.position,
             normal: &t.normal,
+            albedo: &t.albedo,
             vertices: &o.vertices,
             indices: &o.indices,
             index_count: o.index_count,
@@ -361,6 +364,7 @@ struct Passes {
     tile_cut: TileCutPass,
     shade: ShadePass,
     debug_view: DebugViewPass,
+    diffuse: DiffusePass,
     tonemap: TonemapPass,
 }
 
@@ -371,6 +375,7 @@ impl Passes {
             tile_cut: TileCutPass::new(ctx)?,
             shade: ShadePass::new(ctx)?,
             debug_view: DebugViewPass::new(ctx)?,
+            diffuse: DiffusePass::new(ctx)?,
             tonemap: TonemapPass::new(ctx)?,
         })
     }
@@ -402,6 +407,16 @@ impl HierarchyPasses {
         self.record_among(rec, h, vertices, indices, &[(vertices, indices, h.index_count)])
     }
 
+    /// Every mesh of `casters` into the maps of `shadows`.
+    pub fn record_shadows(
+        &self,
+        rec: &mut Recorder,
+        casters: &[(&Buffer, &Buffer, u32)],
+        shadows: &Shadows,
+    ) -> Result<()> {
+        self.shadow.record(rec, casters, &shadows.shadow_map, &shadows.layer_matrices)
+    }
+
     /// The same among other objects: `casters` (every object's mesh, this one's included) cast
     /// the shadows its irradiance sees.
     pub fn record_among(
@@ -420,7 +435,7 @@ impl HierarchyPasses {
         })?;
         // Depth of every object from each light, into the layers of one shadow map.
         let shadows = &h.shadows;
-        rec.scope("shadow maps", |rec| self.shadow.record(rec, casters, &shadows.shadow_map, &shadows.layer_matrices))?;
+        rec.scope("shadow maps", |rec| self.record_shadows(rec, casters, shadows))?;
         // Per point and light: the light entering the surface, and its direction.
         rec.scope("irradiance", |rec| {
             let (points, records, lights) = (&h.points, &h.point_lights, &shadows.lights);
@@ -486,8 +501,21 @@ impl Renderer {
         }
         let cut = shading && !integration.brute_force;
         let objects = self.world.objects.len();
-        let casters: Vec<_> = self.world.objects.iter().map(|o| (&o.vertices, &o.indices, o.index_count)).collect();
+        let w = &self.world;
+        let opaque_meshes = w.opaque.iter().map(|o| (&o.vertices, &o.indices, o.index_count));
+        let casters: Vec<_> =
+            w.objects.iter().map(|o| (&o.vertices, &o.indices, o.index_count)).chain(opaque_meshes).collect();
         let inputs: Vec<ShadeInputs> = (0..objects).map(|k| shade_inputs!(self, k)).collect();
+        // Opaque objects' G-buffer ids follow the translucent ones'.
+        let opaque: Vec<OpaqueDraw> = (w.opaque.iter().enumerate())
+            .map(|(j, o)| OpaqueDraw {
+                vertices: &o.vertices,
+                indices: &o.indices,
+                index_count: o.index_count,
+                uvs: &o.uvs,
+                constants: o.surface_constants(view_projection, (objects + j) as u32),
+            })
+            .collect();
         if let Some(p) = self.profiler.as_mut() {
             p.begin_frame();
         }
@@ -497,8 +525,21 @@ impl Renderer {
                 // `HierarchyPasses::record`), its shadow maps seeing every object.
                 self.passes.hierarchy.record_among(rec, &o.hierarchy, &o.vertices, &o.indices, &casters)?;
             }
-            // The depth pre-pass and the G-buffer (world position with the object, normal).
-            rec.scope("surface", |rec| self.passes.shade.record_surface(rec, &inputs, &constants))?;
+            if let Some(shadows) = &w.opaque_shadows {
+                // The opaque objects' shadow maps, of every object.
+                rec.scope("shadow maps", |rec| self.passes.hierarchy.record_shadows(rec, &casters, shadows))?;
+            }
+            // The depth pre-pass and the G-buffer (world position with the object, normal, and
+            // the reflectance of opaque objects).
+            rec.scope("surface", |rec| self.passes.shade.record_surface(rec, &inputs, &opaque, &constants))?;
+            if let Some(shadows) = w.opaque_shadows.as_ref().filter(|_| shading) {
+                // The opaque objects' reflection of the lights.
+                let t = &self.targets;
+                let gbuffer = (&t.position, &t.normal, &t.albedo);
+                rec.scope("diffuse", |rec| {
+                    self.passes.diffuse.record(rec, &t.color, gbuffer, shadows, objects as u32)
+                })?;
+            }
             for k in 0..objects {
                 if cut {
                     // Per tile, the sources of this object far enough for every pixel of it.
@@ -511,7 +552,7 @@ impl Renderer {
             }
             Ok(())
         })?;
-        drop(inputs);
+        drop((inputs, opaque));
         for k in 0..objects {
             if !cut {
                 break;
@@ -640,6 +681,8 @@ struct Targets {
     depth: Image,
     position: Image,
     normal: Image,
+    /// The reflectance of opaque objects (the surface pass writes it, the diffuse pass reads it).
+    albedo: Image,
     readback: Buffer,
     ldr: Buffer,
 }
@@ -661,6 +704,7 @@ impl Targets {
             Image::new_2d(ctx, name, shade::SURFACE_FORMAT, extent, 1, usage)
         };
         let (position, normal) = (surface("surface position")?, surface("surface normal")?);
+        let albedo = surface("surface albedo")?;
         let readback_bytes = extent.width as u64 * extent.height as u64 * 16;
         let readback =
             Buffer::new(ctx, "readback", readback_bytes, BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)?;
@@ -672,6 +716,6 @@ impl Targets {
             BufferUsageFlags::STORAGE_BUFFER | BufferUsageFlags::TRANSFER_SRC,
             MemoryLocation::GpuToCpu,
         )?;
-        Ok(Targets { extent, color, depth, position, normal, readback, ldr })
+        Ok(Targets { extent, color, depth, position, normal, albedo, readback, ldr })
     }
 }

@@ -9,14 +9,15 @@ use crate::bad_input;
 use crate::budget::{self, FrameSizes};
 use crate::error::Result;
 use crate::frame_desc::FrameDesc;
-use crate::gpu::{GpuChannel, ObjectParams, SdTable};
+use crate::gpu::{DiffuseSurfaceConstants, GpuChannel, ObjectParams, SdTable};
 use crate::hierarchy::{self, Hierarchy, HierarchyOptions};
 use crate::materials::Material;
 use crate::mesh::Mesh;
 use crate::physics::Diffusion;
 use crate::scene::Light;
+use crate::shadows::Shadows;
 use crate::vk::{self, Buffer, BufferUsageFlags, Context, MemoryLocation};
-use crate::world::World;
+use crate::world::{Opaque, Reflectance, World};
 
 /// One object on the GPU.
 pub struct GpuObject {
@@ -44,10 +45,47 @@ struct MadeFrom {
     samples: Option<u32>,
 }
 
+/// One opaque object on the GPU.
+pub struct GpuOpaque {
+    pub vertices: Buffer,
+    pub indices: Buffer,
+    pub index_count: u32,
+    /// One uv per vertex (zeros when the mesh has none).
+    pub uvs: Buffer,
+    pub bounds: (Vec3, Vec3),
+    /// What it was made from.
+    pub made_from: Opaque,
+}
+
+impl GpuOpaque {
+    fn new(ctx: &Context, opaque: &Opaque) -> Result<GpuOpaque> {
+        let mesh = opaque.world_mesh();
+        let (vertices, indices, index_count) = upload_mesh(ctx, &mesh)?;
+        let uvs: Vec<[f32; 2]> = match &opaque.uvs {
+            Some(uvs) => uvs.iter().map(|uv| uv.to_array()).collect(),
+            None => vec![[0.0; 2]; mesh.positions.len()],
+        };
+        let uvs = vk::upload_buffer(ctx, "uvs", &uvs, BufferUsageFlags::STORAGE_BUFFER)?;
+        Ok(GpuOpaque { vertices, indices, index_count, uvs, bounds: mesh.bounds(), made_from: opaque.clone() })
+    }
+
+    /// Its draw into the G-buffer as object `id`, seen through `view_projection`.
+    pub fn surface_constants(&self, view_projection: glam::Mat4, id: u32) -> DiffuseSurfaceConstants {
+        let (tex1, tex2, checker) = match self.made_from.reflectance {
+            Reflectance::Constant(c) => (c.extend(1.0), c.extend(1.0), 0),
+            Reflectance::Checkerboard { uscale, vscale, tex1, tex2 } => (tex1.extend(uscale), tex2.extend(vscale), 1),
+        };
+        DiffuseSurfaceConstants { view_projection, tex1, tex2, object: id, checker, pad: [0; 2] }
+    }
+}
+
 /// The world's objects on the GPU, and the light layout their hierarchies were made for.
 #[derive(Default)]
 pub struct GpuWorld {
     pub objects: Vec<GpuObject>,
+    pub opaque: Vec<GpuOpaque>,
+    /// The lights and the shadow maps fitted to the opaque objects (when there are any).
+    pub opaque_shadows: Option<Shadows>,
     lights: Vec<Light>,
     shadow_resolution: u32,
 }
@@ -99,10 +137,12 @@ impl GpuWorld {
         )?;
         let diffusion = desc.integration.diffusion;
         let bounds: Vec<(Vec3, Vec3)> = world.objects.iter().map(|o| o.world_mesh().bounds()).collect();
+        let opaque_bounds = world.opaque.iter().map(|o| o.world_mesh().bounds()).reduce(union);
         for (i, (object, &point_count)) in world.objects.iter().zip(&point_counts).enumerate() {
             let mesh = object.world_mesh();
             // The other objects, whose shadows this one's maps must see.
-            let others = bounds.iter().enumerate().filter(|&(j, _)| j != i).map(|(_, b)| *b).reduce(union);
+            let others = bounds.iter().enumerate().filter(|&(j, _)| j != i).map(|(_, b)| *b).chain(opaque_bounds);
+            let others = others.reduce(union);
             let options = HierarchyOptions {
                 point_count,
                 shadow_resolution: desc.shadow_resolution,
@@ -163,14 +203,55 @@ impl GpuWorld {
                 write_params(&mut g.params, &mut g.dipole_table, &g.made_from, point_count)?;
             }
         }
+        self.sync_opaque(ctx, world, desc, relayout, bounds.into_iter().reduce(union))?;
         self.lights = desc.lights.clone();
         self.shadow_resolution = desc.shadow_resolution;
         Ok(())
     }
 
+    /// The opaque objects' buffers (made again when an object changes) and their shadow maps,
+    /// fitted to them with the translucent objects (`translucent`, their box) as casters.
+    fn sync_opaque(
+        &mut self,
+        ctx: &Context,
+        world: &World,
+        desc: &FrameDesc,
+        relayout: bool,
+        translucent: Option<(Vec3, Vec3)>,
+    ) -> Result<()> {
+        if self.opaque.len() > world.opaque.len() {
+            ctx.wait_idle()?;
+            self.opaque.truncate(world.opaque.len());
+        }
+        for (j, o) in world.opaque.iter().enumerate() {
+            match self.opaque.get_mut(j) {
+                None => self.opaque.push(GpuOpaque::new(ctx, o)?),
+                Some(g) if g.made_from != *o => {
+                    ctx.wait_idle()?;
+                    *g = GpuOpaque::new(ctx, o)?;
+                }
+                Some(_) => {}
+            }
+        }
+        let Some((lo, hi)) = self.opaque.iter().map(|o| o.bounds).reduce(union) else {
+            self.opaque_shadows = None;
+            return Ok(());
+        };
+        if relayout || self.opaque_shadows.is_none() {
+            ctx.wait_idle()?;
+            self.opaque_shadows = Some(Shadows::new(ctx, &desc.lights, desc.shadow_resolution, 1.0)?);
+        }
+        if let Some(shadows) = self.opaque_shadows.as_mut() {
+            shadows.set_casters(translucent);
+            shadows.set_lights((lo + hi) * 0.5, (hi - lo).length() * 0.5, &desc.lights)?;
+        }
+        Ok(())
+    }
+
     /// The box around every object.
     pub fn bounds(&self) -> (Vec3, Vec3) {
-        self.objects.iter().map(|o| o.bounds).reduce(union).unwrap_or((Vec3::ZERO, Vec3::ZERO))
+        let opaque = self.opaque.iter().map(|o| o.bounds);
+        self.objects.iter().map(|o| o.bounds).chain(opaque).reduce(union).unwrap_or((Vec3::ZERO, Vec3::ZERO))
     }
 }
 

@@ -4,7 +4,7 @@
 
 use std::borrow::Cow;
 
-use glam::{Mat3, Mat4, Vec3};
+use glam::{Mat3, Mat4, Vec2, Vec3};
 
 use crate::bad_input;
 use crate::error::Result;
@@ -37,28 +37,105 @@ impl Object {
     /// transpose, and the winding reversed by a mirroring transform so it stays counter-clockwise
     /// seen from outside.
     pub fn world_mesh(&self) -> Cow<'_, Mesh> {
-        if self.transform == Mat4::IDENTITY {
-            return Cow::Borrowed(&self.mesh);
+        transformed(&self.mesh, self.transform)
+    }
+}
+
+/// `mesh` by `transform`: positions by it, normals by its inverse transpose, and the winding
+/// reversed by a mirroring transform so it stays counter-clockwise seen from outside.
+fn transformed(mesh: &Mesh, transform: Mat4) -> Cow<'_, Mesh> {
+    if transform == Mat4::IDENTITY {
+        return Cow::Borrowed(mesh);
+    }
+    let mut mesh = mesh.clone();
+    let normal_matrix = Mat3::from_mat4(transform).inverse().transpose();
+    for p in &mut mesh.positions {
+        *p = transform.transform_point3(*p);
+    }
+    for n in &mut mesh.normals {
+        *n = (normal_matrix * *n).normalize_or_zero();
+    }
+    if Mat3::from_mat4(transform).determinant() < 0.0 {
+        mesh.flip_winding();
+    }
+    Cow::Owned(mesh)
+}
+
+/// How an opaque surface reflects: Lambertian, with this reflectance (each channel in [0, 1]).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Reflectance {
+    Constant(Vec3),
+    /// pbrt-v4's 2D checkerboard over the mesh's uv: `tex1` where ⌊u·uscale⌋ + ⌊v·vscale⌋ is
+    /// even, `tex2` where odd.
+    Checkerboard {
+        uscale: f32,
+        vscale: f32,
+        tex1: Vec3,
+        tex2: Vec3,
+    },
+}
+
+/// An opaque object: it reflects light (Lambertian) and casts shadows on every object; light
+/// does not scatter into it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Opaque {
+    pub mesh: Mesh,
+    /// One per vertex of `mesh`, when it has them (a checkerboard needs them).
+    pub uvs: Option<Vec<Vec2>>,
+    pub transform: Mat4,
+    pub reflectance: Reflectance,
+}
+
+impl Opaque {
+    pub fn new(mesh: Mesh, reflectance: Reflectance) -> Opaque {
+        Opaque { mesh, uvs: None, transform: Mat4::IDENTITY, reflectance }
+    }
+
+    pub fn world_mesh(&self) -> Cow<'_, Mesh> {
+        transformed(&self.mesh, self.transform)
+    }
+
+    fn validate(&self) -> Result<()> {
+        if !self.transform.is_finite() || Mat3::from_mat4(self.transform).determinant() == 0.0 {
+            return Err(bad_input!("an opaque object's transform is not finite or not invertible"));
         }
-        let mut mesh = self.mesh.clone();
-        let normal_matrix = Mat3::from_mat4(self.transform).inverse().transpose();
-        for p in &mut mesh.positions {
-            *p = self.transform.transform_point3(*p);
+        self.world_mesh().validate()?;
+        let in_range = |c: Vec3| c.is_finite() && c.min_element() >= 0.0 && c.max_element() <= 1.0;
+        let ok = match self.reflectance {
+            Reflectance::Constant(c) => in_range(c),
+            Reflectance::Checkerboard { uscale, vscale, tex1, tex2 } => {
+                if self.uvs.is_none() {
+                    return Err(bad_input!("a checkerboard reflectance needs the mesh's uv coordinates"));
+                }
+                uscale.is_finite() && vscale.is_finite() && in_range(tex1) && in_range(tex2)
+            }
+        };
+        if !ok {
+            return Err(bad_input!(
+                "reflectance {:?}: each channel must be within [0, 1] (and scales finite)",
+                self.reflectance
+            ));
         }
-        for n in &mut mesh.normals {
-            *n = (normal_matrix * *n).normalize_or_zero();
+        if let Some(uvs) = &self.uvs {
+            if uvs.len() != self.mesh.positions.len() || uvs.iter().any(|uv| !uv.is_finite()) {
+                return Err(bad_input!(
+                    "{} uv coordinates for {} vertices, or not finite",
+                    uvs.len(),
+                    self.mesh.positions.len()
+                ));
+            }
         }
-        if Mat3::from_mat4(self.transform).determinant() < 0.0 {
-            mesh.flip_winding();
-        }
-        Cow::Owned(mesh)
+        Ok(())
     }
 }
 
 /// Everything drawn, in one scale.
 #[derive(Clone, Debug, PartialEq)]
 pub struct World {
+    /// The translucent objects (at least one).
     pub objects: Vec<Object>,
+    /// Opaque objects: they reflect the lights and cast shadows.
+    pub opaque: Vec<Opaque>,
     /// Millimetres per world unit (materials are given per mm).
     pub mm_per_unit: f32,
 }
@@ -66,14 +143,17 @@ pub struct World {
 impl World {
     /// A world of one object.
     pub fn single(mesh: Mesh, material: Material, mm_per_unit: f32) -> World {
-        World { objects: vec![Object::new(mesh, material)], mm_per_unit }
+        World { objects: vec![Object::new(mesh, material)], opaque: Vec::new(), mm_per_unit }
     }
 
     /// Every check of the world, with the flag each comes from named: the scale, each mesh (and
     /// its size in millimetres), each material, and the coefficients the GPU can hold in f32.
     pub fn validate(&self) -> Result<()> {
         if self.objects.is_empty() {
-            return Err(bad_input!("the world has no objects"));
+            return Err(bad_input!("the world has no translucent object"));
+        }
+        for o in &self.opaque {
+            o.validate()?;
         }
         for object in &self.objects {
             if !object.transform.is_finite() || Mat3::from_mat4(object.transform).determinant() == 0.0 {
@@ -87,9 +167,11 @@ impl World {
 
     /// The box around every object, in world coordinates.
     pub fn bounds(&self) -> (Vec3, Vec3) {
+        let opaque = self.opaque.iter().map(|o| o.world_mesh().bounds());
         self.objects
             .iter()
             .map(|o| o.world_mesh().bounds())
+            .chain(opaque)
             .fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), (a, b)| (lo.min(a), hi.max(b)))
     }
 }

@@ -42,8 +42,12 @@ fn two_objects_side_by_side_equal_each_alone() {
     (desc.width, desc.height, desc.shadow_resolution) = (96, 48, 512);
     for brute_force in [false, true] {
         desc.integration.brute_force = brute_force;
-        let both = render(&World { objects: vec![sphere.clone(), torus.clone()], mm_per_unit: 10.0 }, &desc);
-        let alone = [&sphere, &torus].map(|o| render(&World { objects: vec![o.clone()], mm_per_unit: 10.0 }, &desc));
+        let both = render(
+            &World { objects: vec![sphere.clone(), torus.clone()], opaque: Vec::new(), mm_per_unit: 10.0 },
+            &desc,
+        );
+        let alone = [&sphere, &torus]
+            .map(|o| render(&World { objects: vec![o.clone()], opaque: Vec::new(), mm_per_unit: 10.0 }, &desc));
         let mut covered = [0usize; 2];
         for (i, p) in both.pixels.iter().enumerate() {
             let owners: Vec<usize> = (0..2).filter(|&k| alone[k].pixels[i][3] > 0.0).collect();
@@ -74,8 +78,8 @@ fn an_object_between_the_light_and_another_shadows_it() {
     let light = Light::Directional { toward: Vec3::Y, irradiance: Vec3::ONE };
     let mut desc = FrameDesc::new(camera, vec![light]);
     (desc.width, desc.height, desc.specular) = (64, 64, false);
-    let alone = render(&World { objects: vec![sphere.clone()], mm_per_unit: 10.0 }, &desc);
-    let shaded = render(&World { objects: vec![sphere, slab], mm_per_unit: 10.0 }, &desc);
+    let alone = render(&World { objects: vec![sphere.clone()], opaque: Vec::new(), mm_per_unit: 10.0 }, &desc);
+    let shaded = render(&World { objects: vec![sphere, slab], opaque: Vec::new(), mm_per_unit: 10.0 }, &desc);
     // The sphere's pixels: those below the slab's projection in the image (the lower half).
     let mean = |img: &HdrImage| {
         let rows = img.height / 2 + 8..img.height;
@@ -85,4 +89,72 @@ fn an_object_between_the_light_and_another_shadows_it() {
     };
     let (a, s) = (mean(&alone), mean(&shaded));
     assert!(a > 0.0 && s < 0.2 * a, "the slab's shadow must darken the sphere: {s} vs {a} alone");
+}
+
+/// A floor quad of side `size` at height `y`, facing up, with uv over [0, 1]².
+fn floor(size: f32, y: f32) -> (Mesh, Vec<glam::Vec2>) {
+    let h = size / 2.0;
+    let positions = vec![Vec3::new(-h, y, -h), Vec3::new(h, y, -h), Vec3::new(h, y, h), Vec3::new(-h, y, h)];
+    let uvs = vec![
+        glam::Vec2::new(0.0, 0.0),
+        glam::Vec2::new(1.0, 0.0),
+        glam::Vec2::new(1.0, 1.0),
+        glam::Vec2::new(0.0, 1.0),
+    ];
+    // Counter-clockwise seen from above.
+    let mesh = Mesh { positions, normals: vec![Vec3::Y; 4], indices: vec![0, 2, 1, 0, 3, 2] };
+    (mesh, uvs)
+}
+
+/// A translucent sphere on an opaque checkerboard floor under a light from above: the sphere's
+/// pixels equal the sphere alone (the floor is below it: no shadow, no scattering into it); the
+/// floor shows both squares of the checker, with the radiance ρ E/π where lit, and the sphere's
+/// shadow under it.
+#[test]
+fn a_sphere_on_a_checker_floor() {
+    use translucent::world::{Opaque, Reflectance};
+    let sphere = placed(Mesh::sphere(0.8, 24), "marble", Vec3::new(0.0, 0.8, 0.0), 4096);
+    let (mesh, uvs) = floor(6.0, 0.0);
+    let (dark, light) = (Vec3::splat(0.1), Vec3::new(0.8, 0.7, 0.6));
+    let mut floor = Opaque::new(mesh, Reflectance::Checkerboard { uscale: 6.0, vscale: 6.0, tex1: dark, tex2: light });
+    floor.uvs = Some(uvs);
+    let camera =
+        Camera { eye: Vec3::new(0.0, 3.0, 5.0), target: Vec3::new(0.0, 0.3, 0.0), up: Vec3::Y, fov_y_deg: 45.0 };
+    let e = 2.0;
+    let light_dir = Vec3::new(0.0, 1.0, 0.0);
+    let mut desc = FrameDesc::new(camera, vec![Light::Directional { toward: light_dir, irradiance: Vec3::splat(e) }]);
+    (desc.width, desc.height, desc.shadow_resolution) = (96, 72, 1024);
+    let alone = render(&World { objects: vec![sphere.clone()], opaque: Vec::new(), mm_per_unit: 10.0 }, &desc);
+    let scene = render(&World { objects: vec![sphere], opaque: vec![floor], mm_per_unit: 10.0 }, &desc);
+    let path = common::output_dir().join("sphere-on-checkers.png");
+    translucent::output::write_image(&path, &scene, translucent::output::Exposure::Stops(0.0)).unwrap();
+    let (mut sphere_pixels, mut floor_values) = (0, Vec::new());
+    for (i, (p, q)) in scene.pixels.iter().zip(&alone.pixels).enumerate() {
+        if q[3] > 0.0 {
+            sphere_pixels += 1;
+            assert!(p.map(f32::to_bits) == q.map(f32::to_bits), "sphere pixel {i}: {p:?} on the floor, {q:?} alone");
+        } else if p[3] > 0.0 {
+            floor_values.push((i, p[0]));
+        }
+    }
+    assert!(sphere_pixels > 300, "{sphere_pixels}");
+    // Lit floor: ρ E / π exactly for each square (f32 rounding aside); shadowed: 0.
+    let (lit_dark, lit_light) = (dark.x * e / std::f32::consts::PI, light.x * e / std::f32::consts::PI);
+    let close = |v: f32, want: f32| (v - want).abs() <= 1e-5 * want;
+    let count = |want: f32| floor_values.iter().filter(|&&(_, v)| close(v, want)).count();
+    let shadowed = floor_values.iter().filter(|&&(_, v)| v == 0.0).count();
+    assert!(
+        count(lit_dark) > 200 && count(lit_light) > 200,
+        "both squares lit: {} {}",
+        count(lit_dark),
+        count(lit_light)
+    );
+    assert!(shadowed > 30, "the sphere's shadow on the floor: {shadowed} pixels");
+    let other = floor_values.len() - count(lit_dark) - count(lit_light) - shadowed;
+    // Only the shadow's edge (the map's texels) lies in between.
+    assert!(
+        other < floor_values.len() / 10,
+        "{other} of {} floor pixels neither lit nor in shadow",
+        floor_values.len()
+    );
 }

@@ -25,3 +25,29 @@ pub struct WorkCounters {
     /// Sd evaluations (three channels each): a point is one per light, a node used whole two.
     pub evaluation_sum: u32,
 }
+
+/// Mirrors `DiffuseSurfaceConstants` in shaders/include/diffuse_constants.glsl: an opaque
+/// object's draw into the G-buffer.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct DiffuseSurfaceConstants {
+    pub view_projection: Mat4,
+    /// rgb: the reflectance (a checkerboard's first); w: the checkerboard's u scale.
+    pub tex1: Vec4,
+    /// rgb: a checkerboard's second reflectance; w: its v scale.
+    pub tex2: Vec4,
+    /// The object's G-buffer id (position w = object + 1).
+    pub object: u32,
+    /// 1 for a checkerboard over the mesh's uv.
+    pub checker: u32,
+    pub pad: [u32; 2],
+}
+
+/// Mirrors `DiffuseConstants` in shaders/include/diffuse_constants.glsl: the diffuse pass.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct DiffuseConstants {
+    /// G-buffer ids from here on are opaque objects.
+    pub first_opaque: u32,
+    pub pad: [u32; 3],
+}

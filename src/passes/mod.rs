@@ -2,6 +2,7 @@
 
 pub mod bssrdf_eval;
 pub mod debug_view;
+pub mod diffuse;
 pub mod irradiance;
 pub mod sampling;
 pub mod shade;

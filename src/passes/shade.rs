@@ -10,7 +10,7 @@
 use std::collections::HashMap;
 
 use crate::error::Result;
-use crate::gpu::ShadeConstants;
+use crate::gpu::{DiffuseSurfaceConstants, ShadeConstants};
 use crate::physics::Model;
 use crate::vk::{
     self, Bind, Buffer, Context, CullModeFlags, Format, GraphicsDesc, Image, Pipeline, PrimitiveTopology, Recorder,
@@ -33,6 +33,8 @@ pub struct ShadeInputs<'a> {
     pub depth: &'a Image,
     pub position: &'a Image,
     pub normal: &'a Image,
+    /// The G-buffer's reflectance of opaque objects.
+    pub albedo: &'a Image,
     pub vertices: &'a Buffer,
     pub indices: &'a Buffer,
     pub index_count: u32,
@@ -86,9 +88,21 @@ pub fn shade_units(width: u32, height: u32, tile: u32, brute_force_points: Optio
     units
 }
 
+/// An opaque object's draw into the G-buffer.
+pub struct OpaqueDraw<'a> {
+    pub vertices: &'a Buffer,
+    pub indices: &'a Buffer,
+    pub index_count: u32,
+    /// One uv per vertex.
+    pub uvs: &'a Buffer,
+    pub constants: DiffuseSurfaceConstants,
+}
+
 pub struct ShadePass {
-    /// The mesh to the G-buffer (depth, position, normal).
+    /// The translucent objects' meshes to the G-buffer (depth, position, normal).
     surface: Pipeline,
+    /// The opaque objects' meshes, with their reflectance.
+    surface_diffuse: Pipeline,
     /// Shading per model and blending (additive for brute force in several draws), made on
     /// first use.
     shading: HashMap<(Model, bool), Pipeline>,
@@ -127,7 +141,7 @@ impl ShadePass {
                 vertex_stride: VERTEX_STRIDE,
                 vertex_attributes: &[(0, Format::R32G32B32_SFLOAT, 0), (1, Format::R32G32B32_SFLOAT, 12)],
                 topology: PrimitiveTopology::TRIANGLE_LIST,
-                color_formats: &[SURFACE_FORMAT, SURFACE_FORMAT],
+                color_formats: &[SURFACE_FORMAT, SURFACE_FORMAT, SURFACE_FORMAT],
                 depth_format: Some(DEPTH_FORMAT),
                 depth_test: true,
                 depth_bias: false,
@@ -136,7 +150,24 @@ impl ShadePass {
                 specialization: &[],
             },
         )?;
-        Ok(ShadePass { surface, shading: HashMap::new() })
+        let surface_diffuse = Pipeline::graphics(
+            ctx,
+            &GraphicsDesc {
+                vertex_shader: "surface_diffuse.vert",
+                fragment_shader: Some("surface_diffuse.frag"),
+                vertex_stride: VERTEX_STRIDE,
+                vertex_attributes: &[(0, Format::R32G32B32_SFLOAT, 0), (1, Format::R32G32B32_SFLOAT, 12)],
+                topology: PrimitiveTopology::TRIANGLE_LIST,
+                color_formats: &[SURFACE_FORMAT, SURFACE_FORMAT, SURFACE_FORMAT],
+                depth_format: Some(DEPTH_FORMAT),
+                depth_test: true,
+                depth_bias: false,
+                cull_mode: CullModeFlags::NONE,
+                additive_blend: false,
+                specialization: &[],
+            },
+        )?;
+        Ok(ShadePass { surface, surface_diffuse, shading: HashMap::new() })
     }
 
     /// Makes the shading pipeline of `model` (and its additive twin for brute force) if not made
@@ -151,28 +182,40 @@ impl ShadePass {
     }
 
     /// Clears the colour target and the work counters and rasterises every object's mesh into
-    /// the G-buffer (its position's w is the object's index + 1).
+    /// the G-buffer: the translucent `objects` (position w = index + 1), then the `opaque` ones
+    /// (w = their id + 1, with their reflectance).
     pub fn record_surface(
         &self,
         rec: &mut Recorder,
         objects: &[ShadeInputs],
+        opaque: &[OpaqueDraw],
         constants: &ShadeConstants,
     ) -> Result<()> {
         let inputs = objects.first().ok_or_else(|| crate::runtime!("surface: no objects"))?;
         rec.fill_buffer(inputs.work, 0)?;
         rec.begin_rendering(&[(inputs.color, Some([0.0; 4]))], None, 0)?;
         rec.end_rendering();
-        for o in objects {
-            rec.use_buffer(o.vertices, vk::Access::VERTEX_INPUT)?;
-            rec.use_buffer(o.indices, vk::Access::INDEX_INPUT)?;
+        let translucent = objects.iter().map(|o| (o.vertices, o.indices));
+        for (vertices, indices) in translucent.chain(opaque.iter().map(|o| (o.vertices, o.indices))) {
+            rec.use_buffer(vertices, vk::Access::VERTEX_INPUT)?;
+            rec.use_buffer(indices, vk::Access::INDEX_INPUT)?;
         }
-        let targets = [(inputs.position, Some([0.0; 4])), (inputs.normal, Some([0.0; 4]))];
+        for o in opaque {
+            rec.prepare_draw_reads(&[Bind::Read(o.uvs)])?;
+        }
+        let clear = Some([0.0; 4]);
+        let targets = [(inputs.position, clear), (inputs.normal, clear), (inputs.albedo, clear)];
         rec.begin_rendering(&targets, Some((inputs.depth, Some(1.0))), 0)?;
         for (k, o) in objects.iter().enumerate() {
             let mut c = *constants;
             c.point_range.z = k as u32;
             let (v, i) = (Some(o.vertices), Some(o.indices));
             rec.draw(&self.surface, &[], vk::bytes_of(&c), v, i, o.index_count, 1)?;
+        }
+        for o in opaque {
+            let (v, i) = (Some(o.vertices), Some(o.indices));
+            let binds = [Bind::Read(o.uvs)];
+            rec.draw(&self.surface_diffuse, &binds, vk::bytes_of(&o.constants), v, i, o.index_count, 1)?;
         }
         rec.end_rendering();
         Ok(())

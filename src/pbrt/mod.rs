@@ -462,7 +462,8 @@ pub fn render_settings(
     let scene_out = crate::settings::rescaled(Scene { mesh, camera: cam, lights, mm_per_unit }, radius);
     let mut object = crate::world::Object::new(scene_out.mesh, material);
     object.samples = args.samples;
-    settings.world = crate::world::World { objects: vec![object], mm_per_unit: scene_out.mm_per_unit };
+    settings.world =
+        crate::world::World { objects: vec![object], opaque: Vec::new(), mm_per_unit: scene_out.mm_per_unit };
     (settings.desc.camera, settings.desc.lights) = (scene_out.camera, scene_out.lights);
     settings.desc.validate()?;
     settings.world.validate()?;
