@@ -225,3 +225,68 @@ where
     root.present().map_err(err)?;
     Ok(())
 }
+
+/// One line of the albedo plot: a label, a colour, whether it is drawn as points (the path
+/// tracer) or a line, and its (α', total diffuse reflectance) pairs.
+pub struct AlbedoSeries {
+    pub label: String,
+    pub colour: RGBColor,
+    pub points_only: bool,
+    pub points: Vec<(f64, f64)>,
+}
+
+/// The thick slab's total diffuse reflectance against the reduced albedo (light at normal
+/// incidence), one series per model and the path tracer's points, as a PNG.
+pub fn write_albedo_plot(title: &str, series: &[AlbedoSeries], path: &Path) -> Result<()> {
+    register_font()?;
+    const SIZE: (u32, u32) = (1100, 700);
+    let mut rgb = vec![0u8; (SIZE.0 * SIZE.1 * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, SIZE).into_drawing_area();
+        let err = |e: DrawingAreaErrorKind<_>| runtime!("plot: {e}");
+        root.fill(&WHITE).map_err(err)?;
+        let y_max = series.iter().flat_map(|s| s.points.iter().map(|p| p.1)).fold(1.0f64, f64::max) * 1.05;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 22))
+            .margin(15)
+            .x_label_area_size(45)
+            .y_label_area_size(70)
+            .build_cartesian_2d(0.3f64..1.0f64, 0.0f64..y_max)
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .x_desc("reduced albedo α' = σ's/σ't")
+            .y_desc("total diffuse reflectance")
+            .label_style(("sans-serif", 15))
+            .draw()
+            .map_err(err)?;
+        for s in series {
+            let colour = s.colour;
+            if s.points_only {
+                chart
+                    .draw_series(s.points.iter().map(|&p| Circle::new(p, 4, colour.filled())))
+                    .map_err(err)?
+                    .label(s.label.clone())
+                    .legend(move |(x, y)| Circle::new((x + 10, y), 4, colour.filled()));
+            } else {
+                chart
+                    .draw_series(LineSeries::new(s.points.iter().copied(), colour.stroke_width(2)))
+                    .map_err(err)?
+                    .label(s.label.clone())
+                    .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], colour.stroke_width(2)));
+            }
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 15))
+            .position(SeriesLabelPosition::UpperLeft)
+            .draw()
+            .map_err(err)?;
+        root.present().map_err(err)?;
+    }
+    let img = image::RgbImage::from_raw(SIZE.0, SIZE.1, rgb).ok_or_else(|| runtime!("plot: buffer size"))?;
+    let bytes = crate::output::encode(img, image::ImageFormat::Png)?;
+    crate::output::write_file(path, &bytes).map_err(|e| runtime!("--out: {e}"))
+}

@@ -8,6 +8,7 @@
 pub mod dipole;
 pub mod dirpole;
 pub mod fresnel;
+pub mod halfspace;
 pub mod microfacet;
 
 /// Which diffusion coefficient the directional dipole uses.
