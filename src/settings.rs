@@ -142,15 +142,20 @@ impl SceneSettings {
     }
 }
 
+/// The power of two that brings a radius far from 1 (outside [1/64, 64]) near it, if it is.
+pub(crate) fn rescale_factor(radius: f32) -> Option<f32> {
+    if (1.0 / 64.0..=64.0).contains(&radius) || radius.is_nan() || radius <= 0.0 {
+        return None;
+    }
+    Some((-radius.log2().round()).exp2())
+}
+
 /// A scene whose mesh is far from unit size (a 1e-9-unit cube, a 1e8-unit terrain) re-expressed in
 /// units a power of two larger or smaller, so that its radius is near 1: the picture is the same
 /// (millimetres per unit change by the inverse factor, exactly), but the hierarchy's half-float
 /// node bounds and the depth range keep their precision.
 pub(crate) fn rescaled(mut scene: Scene, radius: f32) -> Scene {
-    if (1.0 / 64.0..=64.0).contains(&radius) || radius.is_nan() || radius <= 0.0 {
-        return scene;
-    }
-    let factor = (-radius.log2().round()).exp2();
+    let Some(factor) = rescale_factor(radius) else { return scene };
     scene.mesh = scene.mesh.scaled(factor);
     scene.mm_per_unit /= factor;
     scene.camera.eye *= factor;

@@ -270,7 +270,7 @@ pub fn render_settings(
     args: &crate::cli::RenderArgs,
     given: &dyn Fn(&str) -> bool,
 ) -> Result<(crate::cli::RenderArgs, crate::settings::RenderSettings)> {
-    use crate::scene::{Camera, Light, Scene};
+    use crate::scene::{Camera, Light};
     let scene = load(path)?;
     for w in &scene.warnings {
         crate::note!("warning: {w}");
@@ -280,23 +280,20 @@ pub fn render_settings(
     }
     let shown = path.display();
     let not_yet = |loc: &Loc, what: &str| {
-        bad_input!("{loc}: {what} not rendered yet (today a scene renders one shape with a subsurface material, lit by distant and point lights)")
+        bad_input!("{loc}: {what} not rendered yet (today a scene renders shapes with subsurface and diffuse materials, lit by distant and point lights)")
     };
-    let mut translucent = None;
+    let mut translucent = Vec::new();
+    let mut opaque = Vec::new();
     for o in &scene.objects {
         match &o.material {
-            MaterialDesc::Subsurface(s) if translucent.is_none() => translucent = Some((o, s)),
-            MaterialDesc::Subsurface(_) => return Err(not_yet(&o.loc, "a second translucent object is")),
-            _ => {
-                return Err(not_yet(
-                    &o.loc,
-                    &format!("Shape \"{}\" with a diffuse material: opaque objects are", o.shape),
-                ))
-            }
+            MaterialDesc::Subsurface(s) => translucent.push((o, s)),
+            MaterialDesc::Diffuse { reflectance } => opaque.push((o, reflectance_of(reflectance, &o.loc)?)),
+            MaterialDesc::Interface => {}
         }
     }
-    let (object, sub) =
-        translucent.ok_or_else(|| bad_input!("{shown}: no shape with a subsurface material (nothing to render)"))?;
+    let Some(&(_, sub)) = translucent.first() else {
+        return Err(bad_input!("{shown}: no shape with a subsurface material (nothing to render)"));
+    };
     let mut lights = Vec::new();
     for l in &scene.lights {
         let rgb = |c: [f64; 3], s: f64| Vec3::new((c[0] * s) as f32, (c[1] * s) as f32, (c[2] * s) as f32);
@@ -354,24 +351,32 @@ pub fn render_settings(
     let mut settings = crate::settings::RenderSettings::from_args(&stand_in)?;
     (settings.desc.width, settings.desc.height) = (out.width, out.height);
 
-    // The object, the lights and the camera; mirrored when pbrt's camera is left-handed.
-    let mut raw = object.mesh.clone();
+    // The objects, the lights and the camera; mirrored when pbrt's camera is left-handed.
     let (eye, target, up) = (camera.eye, camera.target, camera.up);
-    if camera.left_handed {
-        let n = (target - eye).cross(up).normalize();
-        let mirror = |p: DVec3| p - 2.0 * (p - eye).dot(n) * n;
-        let mirror_v = |v: DVec3| v - 2.0 * v.dot(n) * n;
-        for p in &mut raw.positions {
-            *p = mirror(p.as_dvec3()).as_vec3();
-        }
-        if let Some(ns) = &mut raw.normals {
-            for v in ns.iter_mut() {
-                *v = mirror_v(v.as_dvec3()).as_vec3();
+    let n = (target - eye).cross(up).normalize();
+    let mirror = |p: DVec3| p - 2.0 * (p - eye).dot(n) * n;
+    let mirror_v = |v: DVec3| v - 2.0 * v.dot(n) * n;
+    // Each shape's mesh as the renderer takes it, and its uv.
+    let mesh_of = |o: &Object| -> Result<(crate::mesh::Mesh, Option<Vec<glam::Vec2>>)> {
+        let mut raw = o.mesh.clone();
+        if camera.left_handed {
+            for p in &mut raw.positions {
+                *p = mirror(p.as_dvec3()).as_vec3();
+            }
+            if let Some(ns) = &mut raw.normals {
+                for v in ns.iter_mut() {
+                    *v = mirror_v(v.as_dvec3()).as_vec3();
+                }
+            }
+            for t in raw.indices.chunks_exact_mut(3) {
+                t.swap(1, 2);
             }
         }
-        for t in raw.indices.chunks_exact_mut(3) {
-            t.swap(1, 2);
-        }
+        let uvs = raw.uvs.clone().filter(|uv| uv.len() == raw.positions.len());
+        let shown = format!("{} (Shape \"{}\")", o.loc, o.shape);
+        Ok((crate::mesh::Mesh::from_raw(raw, &shown, crate::mesh::MeshFormat::Ply)?, uvs))
+    };
+    if camera.left_handed {
         for l in &mut lights {
             match l {
                 Light::Directional { toward, .. } => *toward = mirror_v(toward.as_dvec3()).as_vec3(),
@@ -379,11 +384,6 @@ pub fn render_settings(
             }
         }
     }
-    let mesh = crate::mesh::Mesh::from_raw(
-        raw,
-        &format!("{} (Shape \"{}\")", object.loc, object.shape),
-        crate::mesh::MeshFormat::Ply,
-    )?;
     let (w, h) = (out.width as f64, out.height as f64);
     // pbrt's fov spans the shorter side; ours is vertical.
     let fov = if w >= h {
@@ -411,29 +411,32 @@ pub fn render_settings(
         }
         lights = settings.desc.lights.clone();
     }
+    // One scale for the world: the first subsurface material's `scale` (or --scale); other
+    // materials' coefficients are multiplied by their scale over it, which is what pbrt does.
     let mm_per_unit = if given("--scale") { args.scale } else { sub.scale as f32 };
-
-    // The material: the scene's, unless a preset is typed; coefficient flags override either.
-    let m = &args.material;
-    let mut material = if given("--material") {
-        m.material()?
-    } else {
-        let mut mat = crate::materials::Material::custom(sub.sigma_a, sub.sigma_s, [sub.g; 3], sub.eta)
-            .map_err(|e| bad_input!("{}: subsurface: {e}", sub.loc))?;
-        mat.name = match &sub.source {
-            SubsurfaceSource::Named(n) => format!("{n} (pbrt-v4's table)"),
-            SubsurfaceSource::Coefficients => format!("{} subsurface", sub.loc),
-            SubsurfaceSource::Reflectance { .. } => format!("{} subsurface (from reflectance)", sub.loc),
-            SubsurfaceSource::Default => "pbrt-v4's default subsurface".into(),
-        };
-        mat
-    };
-    if !given("--material") {
-        material.sigma_a = m.sigma_a.unwrap_or(material.sigma_a);
-        material.sigma_s = m.sigma_s.unwrap_or(material.sigma_s);
-        material.g = m.g.unwrap_or(material.g);
-        material.eta = m.eta.unwrap_or(material.eta);
-        material.validate()?;
+    let mut objects = Vec::new();
+    for &(o, sub) in &translucent {
+        let mut material = material_of(sub, args, given)?;
+        if !given("--scale") && sub.scale as f32 != mm_per_unit {
+            let f = sub.scale / mm_per_unit as f64;
+            material.sigma_a = material.sigma_a.map(|v| v * f);
+            material.sigma_s = material.sigma_s.map(|v| v * f);
+        }
+        let mut object = crate::world::Object::new(mesh_of(o)?.0, material);
+        object.samples = args.samples;
+        objects.push(object);
+    }
+    let mut opaque_objects = Vec::new();
+    for (o, reflectance) in opaque {
+        let (mesh, uvs) = mesh_of(o)?;
+        if matches!(reflectance, crate::world::Reflectance::Checkerboard { .. }) && uvs.is_none() {
+            return Err(bad_input!(
+                "{}: Shape \"{}\": a checkerboard texture needs the shape's \"point2 uv\"",
+                o.loc,
+                o.shape
+            ));
+        }
+        opaque_objects.push(crate::world::Opaque { uvs, ..crate::world::Opaque::new(mesh, reflectance) });
     }
     if !given("--roughness") {
         // pbrt: α = √roughness when remapped, else α = roughness; ours: α = roughness².
@@ -451,23 +454,83 @@ pub fn render_settings(
 
     crate::frame_desc::check_camera(&cam)?;
     crate::frame_desc::check_lights(&lights)?;
-    mesh.validate()?;
-    let (_, radius) = crate::scene::bounding_sphere(&mesh.positions);
-    let size_mm = 2.0 * radius as f64 * mm_per_unit as f64;
-    let limits = crate::world::SIZE_MM_LIMITS;
-    if !(limits.0..=limits.1).contains(&size_mm) {
-        return Err(bad_input!("{}: the object is {size_mm:.3e} mm across at scale {mm_per_unit} mm per unit; it must be within [{:e}, {:e}] mm", sub.loc, limits.0, limits.1));
+    let mut world = crate::world::World { objects, opaque: opaque_objects, mm_per_unit };
+    for (o, &(_, sub)) in world.objects.iter().zip(&translucent) {
+        o.mesh.validate()?;
+        let (_, radius) = crate::scene::bounding_sphere(&o.mesh.positions);
+        let size_mm = 2.0 * radius as f64 * mm_per_unit as f64;
+        let limits = crate::world::SIZE_MM_LIMITS;
+        if !(limits.0..=limits.1).contains(&size_mm) {
+            return Err(bad_input!("{}: the object is {size_mm:.3e} mm across at scale {mm_per_unit} mm per unit; it must be within [{:e}, {:e}] mm", sub.loc, limits.0, limits.1));
+        }
     }
     // Far from unit size: re-expressed in power-of-two units, as scenes from flags are.
-    let scene_out = crate::settings::rescaled(Scene { mesh, camera: cam, lights, mm_per_unit }, radius);
-    let mut object = crate::world::Object::new(scene_out.mesh, material);
-    object.samples = args.samples;
-    settings.world =
-        crate::world::World { objects: vec![object], opaque: Vec::new(), mm_per_unit: scene_out.mm_per_unit };
-    (settings.desc.camera, settings.desc.lights) = (scene_out.camera, scene_out.lights);
+    let (_, radius) = crate::scene::bounding_sphere(&world.objects[0].mesh.positions);
+    if let Some(factor) = crate::settings::rescale_factor(radius) {
+        for mesh in world.objects.iter_mut().map(|o| &mut o.mesh).chain(world.opaque.iter_mut().map(|o| &mut o.mesh)) {
+            mesh.positions.iter_mut().for_each(|p| *p *= factor);
+        }
+        world.mm_per_unit /= factor;
+        cam.eye *= factor;
+        cam.target *= factor;
+        for l in &mut lights {
+            if let Light::Point { position, .. } = l {
+                *position *= factor;
+            }
+        }
+    }
+    settings.world = world;
+    (settings.desc.camera, settings.desc.lights) = (cam, lights);
     settings.desc.validate()?;
     settings.world.validate()?;
     Ok((out, settings))
+}
+
+/// A subsurface material as the renderer takes it: the scene's, unless a preset is typed;
+/// coefficient flags override either.
+fn material_of(
+    sub: &Subsurface,
+    args: &crate::cli::RenderArgs,
+    given: &dyn Fn(&str) -> bool,
+) -> Result<crate::materials::Material> {
+    let m = &args.material;
+    if given("--material") {
+        return m.material();
+    }
+    let mut mat = crate::materials::Material::custom(sub.sigma_a, sub.sigma_s, [sub.g; 3], sub.eta)
+        .map_err(|e| bad_input!("{}: subsurface: {e}", sub.loc))?;
+    mat.name = match &sub.source {
+        SubsurfaceSource::Named(n) => format!("{n} (pbrt-v4's table)"),
+        SubsurfaceSource::Coefficients => format!("{} subsurface", sub.loc),
+        SubsurfaceSource::Reflectance { .. } => format!("{} subsurface (from reflectance)", sub.loc),
+        SubsurfaceSource::Default => "pbrt-v4's default subsurface".into(),
+    };
+    mat.sigma_a = m.sigma_a.unwrap_or(mat.sigma_a);
+    mat.sigma_s = m.sigma_s.unwrap_or(mat.sigma_s);
+    mat.g = m.g.unwrap_or(mat.g);
+    mat.eta = m.eta.unwrap_or(mat.eta);
+    mat.validate()?;
+    Ok(mat)
+}
+
+/// A diffuse reflectance as the renderer takes it: a constant, or a checkerboard of two constants.
+fn reflectance_of(r: &Reflectance, loc: &Loc) -> Result<crate::world::Reflectance> {
+    let rgb = |c: &[f64; 3]| Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32);
+    match r {
+        Reflectance::Constant(c) => Ok(crate::world::Reflectance::Constant(rgb(c))),
+        Reflectance::Checkerboard { uscale, vscale, tex1, tex2 } => match (tex1.as_ref(), tex2.as_ref()) {
+            (Reflectance::Constant(a), Reflectance::Constant(b)) => Ok(crate::world::Reflectance::Checkerboard {
+                uscale: *uscale as f32,
+                vscale: *vscale as f32,
+                tex1: rgb(a),
+                tex2: rgb(b),
+            }),
+            _ => Err(bad_input!("{loc}: a checkerboard of textures (not of two constants) is not rendered yet")),
+        },
+        Reflectance::ImageMap { path } => {
+            Err(bad_input!("{loc}: \"imagemap\" reflectance ({}) is not rendered yet", path.display()))
+        }
+    }
 }
 
 #[cfg(test)]
