@@ -299,10 +299,10 @@ pub fn render_settings(
         let rgb = |c: [f64; 3], s: f64| Vec3::new((c[0] * s) as f32, (c[1] * s) as f32, (c[2] * s) as f32);
         match l {
             LightDesc::Distant { from, to, l, scale, loc } => {
-                let toward = (*from - *to)
-                    .try_normalize()
+                // Normalised in f32 as `--light dir:` is, so that the same light gives the same bits.
+                let toward = crate::mesh::safe_normalize((*from - *to).as_vec3())
                     .ok_or_else(|| bad_input!("{loc}: LightSource \"distant\": from and to are the same point"))?;
-                lights.push(Light::Directional { toward: toward.as_vec3(), irradiance: rgb(*l, *scale) });
+                lights.push(Light::Directional { toward, irradiance: rgb(*l, *scale) });
             }
             LightDesc::Point { from, i, scale, .. } => {
                 lights.push(Light::Point { position: from.as_vec3(), intensity: rgb(*i, *scale) })

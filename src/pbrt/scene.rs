@@ -43,6 +43,9 @@ struct Parser {
     named_materials: HashMap<String, MaterialDesc>,
     textures: HashMap<String, Texture>,
     coordinate_systems: HashMap<String, DMat4>,
+    /// The last `LookAt`'s eye, point looked at and up, with the CTM it left: a camera declared
+    /// under that CTM takes them as written (the same numbers as `--eye/--target/--up`).
+    look_at: Option<(DMat4, DVec3, DVec3, DVec3)>,
     tokens_read: usize,
     in_world: bool,
     warned: Vec<String>,
@@ -84,6 +87,7 @@ pub fn load(path: &Path) -> Result<PbrtScene, String> {
         named_materials: HashMap::new(),
         textures: HashMap::new(),
         coordinate_systems: HashMap::new(),
+        look_at: None,
         tokens_read: 0,
         in_world: false,
         warned: Vec::new(),
@@ -169,6 +173,7 @@ impl Parser {
                 let world_from_camera =
                     DMat4::from_cols(right.extend(0.0), new_up.extend(0.0), dir.extend(0.0), eye.extend(1.0));
                 self.state.ctm = ctm * world_from_camera.inverse();
+                self.look_at = Some((self.state.ctm, eye, look, up));
             }
             "Transform" | "ConcatTransform" => {
                 let v = bracketed(t, at, 16, loc, name)?;
@@ -243,8 +248,11 @@ impl Parser {
                 // pbrt's camera space is left-handed (x right, y up, z forward): a right-handed
                 // camera sees the mirror image unless the transformation flips it (Scale -1 1 1).
                 let left_handed = right.dot(up.cross(forward)) > 0.0;
-                self.scene.camera =
-                    Some(CameraDesc { eye, target: eye + forward, up, fov_deg: fov, left_handed, loc: loc.clone() });
+                let (eye, target, up) = match self.look_at {
+                    Some((m, e, look, u)) if m == ctm => (e, look, u),
+                    _ => (eye, eye + forward, up),
+                };
+                self.scene.camera = Some(CameraDesc { eye, target, up, fov_deg: fov, left_handed, loc: loc.clone() });
                 self.coordinate_systems.insert("camera".into(), world_from_camera);
                 self.unused(
                     &p,
@@ -549,14 +557,19 @@ impl Parser {
         let m = self.state.ctm;
         let normal_m = m.inverse().transpose();
         let swaps = m.determinant() < 0.0;
-        for v in &mut raw.positions {
-            *v = m.transform_point3(v.as_dvec3()).as_vec3();
-        }
-        if let Some(normals) = &mut raw.normals {
-            let flip = if self.state.reverse_orientation { -1.0 } else { 1.0 };
-            for n in normals.iter_mut() {
-                *n = (normal_m.transform_vector3(n.as_dvec3()).normalize_or_zero() * flip).as_vec3();
+        let flip = if self.state.reverse_orientation { -1.0 } else { 1.0 };
+        if m != DMat4::IDENTITY {
+            for v in &mut raw.positions {
+                *v = m.transform_point3(v.as_dvec3()).as_vec3();
             }
+            if let Some(normals) = &mut raw.normals {
+                for n in normals.iter_mut() {
+                    *n = (normal_m.transform_vector3(n.as_dvec3()).normalize_or_zero() * flip).as_vec3();
+                }
+            }
+        } else if let Some(normals) = raw.normals.as_mut().filter(|_| flip < 0.0) {
+            // In world space already: the file's numbers as they are (as `--mesh` reads them).
+            normals.iter_mut().for_each(|n| *n = -*n);
         }
         if self.state.reverse_orientation != swaps {
             for t in raw.indices.chunks_exact_mut(3) {
