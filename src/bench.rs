@@ -33,6 +33,8 @@ pub struct BenchOptions {
     pub epsilons: Vec<f32>,
     /// Image size (square) of the pbrt-v2 comparison; 0 skips it.
     pub peer_size: u32,
+    /// Image size (square) of the several-object scene; 0 skips it.
+    pub scene_size: u32,
     pub context: ContextOptions,
 }
 
@@ -224,6 +226,9 @@ pub fn run(options: &BenchOptions) -> Result<String> {
         if options.peer_size > 0 {
             out += &peer_comparison(options)?;
         }
+        if options.scene_size > 0 {
+            out += &scene_of_objects(options)?;
+        }
         return Ok(out);
     }
 
@@ -298,6 +303,67 @@ pub fn run(options: &BenchOptions) -> Result<String> {
     if options.peer_size > 0 {
         out += &peer_comparison(options)?;
     }
+    // 6. A scene of several objects, translucent and opaque.
+    if options.scene_size > 0 {
+        out += &scene_of_objects(options)?;
+    }
+    Ok(out)
+}
+
+/// The first mesh in marble and a skin sphere beside it on an opaque checkerboard floor, under
+/// the default back light and a light from the front: every pass at `scene_size`².
+fn scene_of_objects(options: &BenchOptions) -> Result<String> {
+    use crate::frame_desc::FrameDesc;
+    use crate::world::{Object, Opaque, Reflectance, World};
+    let spec = &options.meshes[0];
+    let mesh = Mesh::from_spec(spec)?;
+    let (lo, hi) = mesh.bounds();
+    let (centre, radius) = bounding_sphere(&mesh.positions);
+    let marble = Object::new(mesh, crate::materials::Material::find("marble")?);
+    let mut skin = Object::new(Mesh::sphere(0.5 * radius, 48), crate::materials::Material::find("skin1")?);
+    skin.transform = glam::Mat4::from_translation(Vec3::new(hi.x + 0.7 * radius, lo.y + 0.5 * radius, centre.z));
+    let side = 8.0 * radius;
+    let floor_mesh = Mesh {
+        positions: [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+            .map(|(x, z)| Vec3::new(centre.x + x * side, lo.y, centre.z + z * side))
+            .to_vec(),
+        normals: vec![Vec3::Y; 4],
+        indices: vec![0, 2, 1, 0, 3, 2],
+    };
+    let mut floor = Opaque::new(
+        floor_mesh,
+        Reflectance::Checkerboard { uscale: 16.0, vscale: 16.0, tex1: Vec3::splat(0.1), tex2: Vec3::splat(0.7) },
+    );
+    floor.uvs = Some([(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)].map(|(u, v)| glam::Vec2::new(u, v)).to_vec());
+    let world = World { objects: vec![marble, skin], opaque: vec![floor], mm_per_unit: 10.0 };
+    let camera = Camera::framing(centre, 1.6 * radius, 40.0, Vec3::new(0.4, 0.35, 1.0));
+    let lights = vec![
+        Light::Directional { toward: Vec3::new(-0.3, 0.7, -0.65), irradiance: Vec3::ONE },
+        Light::Directional { toward: Vec3::new(0.5, 0.8, 0.6), irradiance: Vec3::splat(0.5) },
+    ];
+    let mut desc = FrameDesc::new(camera, lights);
+    (desc.width, desc.height) = (options.scene_size, options.scene_size);
+    let ctx = Context::new(&options.context)?;
+    let device = format!("{} ({})", ctx.info.name, ctx.info.driver);
+    let mut renderer = Renderer::new(ctx, true)?;
+    let mut timed = Vec::new();
+    for _ in 0..options.frames.max(2) {
+        timed.push(renderer.render_frame(&world, &desc)?);
+    }
+    timed.remove(0);
+    let points = renderer.point_counts();
+    let passes = summary(&ProfileReport::from_frames(&device, timed));
+    let mut out = format!(
+        "\n### A scene of several objects\n\nDevice: {device}; {s}x{s}: {} in marble and a skin sphere (translucent, {} points), on an opaque checkerboard floor, two directional lights; mean of {} frame(s) after a warm-up.\n\n| pass | ms | share |\n|---|---:|---:|\n",
+        mesh_name(spec),
+        points.iter().map(|n| n.to_string()).collect::<Vec<_>>().join(" and "),
+        options.frames.max(2) - 1,
+        s = options.scene_size
+    );
+    for p in &passes {
+        out += &format!("| {} | {:.1} | {:.0}% |\n", p.name, p.mean_ms, 100.0 * p.share);
+    }
+    crate::note!("bench: the scene of several objects done");
     Ok(out)
 }
 

@@ -159,6 +159,10 @@ pub struct BenchArgs {
     /// sphere itself); 0 skips it.
     #[arg(long, allow_hyphen_values = true, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(0..=16384))]
     pub peer_size: u32,
+    /// Image size (square) of a scene of several objects (two translucent, an opaque floor); 0
+    /// skips it.
+    #[arg(long, allow_hyphen_values = true, default_value_t = 512, value_parser = clap::value_parser!(u32).range(0..=16384))]
+    pub scene_size: u32,
     #[command(flatten)]
     pub device: DeviceArgs,
 }

@@ -230,6 +230,11 @@ impl Renderer {
         self.world.objects.first().map(|o| &o.hierarchy)
     }
 
+    /// Every translucent object's sample count (from the last frame).
+    pub fn point_counts(&self) -> Vec<u32> {
+        self.world.objects.iter().map(|o| o.hierarchy.point_count).collect()
+    }
+
     /// The first object's sample count, once a frame has made its hierarchy.
     pub fn point_count(&self) -> Option<u32> {
         self.hierarchy().map(|h| h.point_count)
@@ -629,23 +634,28 @@ impl Renderer {
         let (view_projection, desc) = (frame.view_projection, &frame.desc);
         self.frames_done += 1;
         self.batching.after_frame(&frame.shading);
-        let hierarchy = &self.world.objects[0].hierarchy;
         let t = &self.targets;
 
         if desc.show == Show::Samples {
-            // Debug view: the sample points coloured by irradiance.
+            // Debug view: every object's sample points coloured by irradiance.
             let debug = DebugConstants { view_projection, color_scale: Vec3::ONE.extend(2.0) };
-            let (points, n) = (&hierarchy.sorted_points, hierarchy.point_count);
+            let objects = &self.world.objects;
             self.ctx.submit(self.profiler.as_mut(), |rec| {
                 rec.scope("show samples", |rec| {
-                    self.passes.debug_view.record_points(rec, &t.color, &t.depth, points, n, &debug)
+                    objects.iter().try_for_each(|o| {
+                        let (points, n) = (&o.hierarchy.sorted_points, o.hierarchy.point_count);
+                        self.passes.debug_view.record_points(rec, &t.color, &t.depth, points, n, &debug)
+                    })
                 })
             })?;
         }
         if let Show::Tree(level) = desc.show {
-            // Debug only: the boxes come from a download of the nodes, drawn in a second submission.
-            let nodes = hierarchy.download(&self.ctx)?.nodes;
-            let lines = debug_view::tree_level_lines(&nodes, level);
+            // Debug only: the boxes come from a download of every object's nodes, drawn in a
+            // second submission.
+            let mut lines = Vec::new();
+            for o in &self.world.objects {
+                lines.extend(debug_view::tree_level_lines(&o.hierarchy.download(&self.ctx)?.nodes, level));
+            }
             if lines.is_empty() {
                 return Err(crate::bad_input!("--level {level}: the tree has no internal nodes that deep"));
             }

@@ -58,6 +58,7 @@ fn bench(args: &BenchArgs) -> Result<i32> {
         accuracy_samples: args.accuracy_samples.clone(),
         epsilons: args.epsilons.clone(),
         peer_size: args.peer_size,
+        scene_size: args.scene_size,
         context: args.device.options(),
     };
     crate::error::write_stdout(&crate::bench::run(&options)?)?;
