@@ -186,8 +186,25 @@ fn push_constants_match_glsl() {
         offset_of!(TileCutConstants, capacity),
         offset_of!(TileCutConstants, light_count),
         offset_of!(TileCutConstants, object),
+        offset_of!(TileCutConstants, pad),
     ];
     assert_eq!(offsets("tile_cut.comp", "TileCutConstants"), cut.map(|o| o as u32));
+    // The opaque objects' passes.
+    use translucent::gpu::{DiffuseConstants, DiffuseSurfaceConstants};
+    let surface = [
+        offset_of!(DiffuseSurfaceConstants, view_projection),
+        offset_of!(DiffuseSurfaceConstants, tex1),
+        offset_of!(DiffuseSurfaceConstants, tex2),
+        offset_of!(DiffuseSurfaceConstants, object),
+        offset_of!(DiffuseSurfaceConstants, checker),
+    ];
+    for shader in ["surface_diffuse.vert", "surface_diffuse.frag"] {
+        let glsl = offsets(shader, "DiffuseSurfaceConstants");
+        assert_eq!(glsl[..surface.len()], surface.map(|o| o as u32), "{shader}");
+    }
+    assert_eq!(size_of::<DiffuseSurfaceConstants>(), 112);
+    assert_eq!(offsets("diffuse.frag", "DiffuseConstants")[0], offset_of!(DiffuseConstants, first_opaque) as u32);
+    assert_eq!(size_of::<DiffuseConstants>(), 16);
     let debug = [offset_of!(DebugConstants, view_projection), offset_of!(DebugConstants, color_scale)];
     for shader in ["debug/points.vert", "debug/lines.vert"] {
         assert_eq!(offsets(shader, "DebugConstants"), debug.map(|o| o as u32), "{shader}");

@@ -106,57 +106,65 @@ fn floor(size: f32, y: f32) -> (Mesh, Vec<glam::Vec2>) {
     (mesh, uvs)
 }
 
-/// A translucent sphere on an opaque checkerboard floor under a light from above: the sphere's
-/// pixels equal the sphere alone (the floor is below it: no shadow, no scattering into it); the
-/// floor shows both squares of the checker, with the radiance ρ E/π where lit, and the sphere's
-/// shadow under it.
+/// A translucent sphere, and the bunny when installed, on an opaque checkerboard floor under a
+/// light from above: the object's pixels equal the object alone (the floor is below it: no
+/// shadow, no scattering into it); the floor shows both squares of the checker, with the radiance
+/// ρ E/π where lit, and the object's shadow under it.
 #[test]
-fn a_sphere_on_a_checker_floor() {
+fn an_object_on_a_checker_floor() {
     use translucent::world::{Opaque, Reflectance};
-    let sphere = placed(Mesh::sphere(0.8, 24), "marble", Vec3::new(0.0, 0.8, 0.0), 4096);
-    let (mesh, uvs) = floor(6.0, 0.0);
-    let (dark, light) = (Vec3::splat(0.1), Vec3::new(0.8, 0.7, 0.6));
-    let mut floor = Opaque::new(mesh, Reflectance::Checkerboard { uscale: 6.0, vscale: 6.0, tex1: dark, tex2: light });
-    floor.uvs = Some(uvs);
-    let camera =
-        Camera { eye: Vec3::new(0.0, 3.0, 5.0), target: Vec3::new(0.0, 0.3, 0.0), up: Vec3::Y, fov_y_deg: 45.0 };
-    let e = 2.0;
-    let light_dir = Vec3::new(0.0, 1.0, 0.0);
-    let mut desc = FrameDesc::new(camera, vec![Light::Directional { toward: light_dir, irradiance: Vec3::splat(e) }]);
-    (desc.width, desc.height, desc.shadow_resolution) = (96, 72, 1024);
-    let alone = render(&World { objects: vec![sphere.clone()], opaque: Vec::new(), mm_per_unit: 10.0 }, &desc);
-    let scene = render(&World { objects: vec![sphere], opaque: vec![floor], mm_per_unit: 10.0 }, &desc);
-    let path = common::output_dir().join("sphere-on-checkers.png");
-    translucent::output::write_image(&path, &scene, translucent::output::Exposure::Stops(0.0)).unwrap();
-    let (mut sphere_pixels, mut floor_values) = (0, Vec::new());
-    for (i, (p, q)) in scene.pixels.iter().zip(&alone.pixels).enumerate() {
-        if q[3] > 0.0 {
-            sphere_pixels += 1;
-            assert!(p.map(f32::to_bits) == q.map(f32::to_bits), "sphere pixel {i}: {p:?} on the floor, {q:?} alone");
-        } else if p[3] > 0.0 {
-            floor_values.push((i, p[0]));
-        }
+    let mut meshes = vec![("sphere", Mesh::sphere(0.8, 24), 4096)];
+    if std::path::Path::new(translucent::settings::BUNNY).exists() {
+        meshes.push(("bunny", Mesh::from_spec(translucent::settings::BUNNY).unwrap(), 16384));
     }
-    assert!(sphere_pixels > 300, "{sphere_pixels}");
-    // Lit floor: ρ E / π exactly for each square (f32 rounding aside); shadowed: 0.
-    let (lit_dark, lit_light) = (dark.x * e / std::f32::consts::PI, light.x * e / std::f32::consts::PI);
-    let close = |v: f32, want: f32| (v - want).abs() <= 1e-5 * want;
-    let count = |want: f32| floor_values.iter().filter(|&&(_, v)| close(v, want)).count();
-    let shadowed = floor_values.iter().filter(|&&(_, v)| v == 0.0).count();
-    assert!(
-        count(lit_dark) > 200 && count(lit_light) > 200,
-        "both squares lit: {} {}",
-        count(lit_dark),
-        count(lit_light)
-    );
-    assert!(shadowed > 30, "the sphere's shadow on the floor: {shadowed} pixels");
-    let other = floor_values.len() - count(lit_dark) - count(lit_light) - shadowed;
-    // Only the shadow's edge (the map's texels) lies in between.
-    assert!(
-        other < floor_values.len() / 10,
-        "{other} of {} floor pixels neither lit nor in shadow",
-        floor_values.len()
-    );
+    for (name, mesh, samples) in meshes {
+        // Standing on the floor at y = 0, 0.8 high.
+        let (lo, hi) = mesh.bounds();
+        let scale = 1.6 / (hi.y - lo.y);
+        let mesh = mesh.scaled(scale);
+        let object = placed(mesh, "marble", Vec3::new(0.0, -lo.y * scale + 1e-3, 0.0), samples);
+        let (floor_mesh, uvs) = floor(6.0, 0.0);
+        let (dark, light) = (Vec3::splat(0.1), Vec3::new(0.8, 0.7, 0.6));
+        let checks = Reflectance::Checkerboard { uscale: 6.0, vscale: 6.0, tex1: dark, tex2: light };
+        let mut floor = Opaque::new(floor_mesh, checks);
+        floor.uvs = Some(uvs);
+        let camera =
+            Camera { eye: Vec3::new(0.0, 3.0, 5.0), target: Vec3::new(0.0, 0.3, 0.0), up: Vec3::Y, fov_y_deg: 45.0 };
+        let e = 2.0;
+        let mut desc = FrameDesc::new(camera, vec![Light::Directional { toward: Vec3::Y, irradiance: Vec3::splat(e) }]);
+        (desc.width, desc.height, desc.shadow_resolution) = (96, 72, 1024);
+        let alone = render(&World { objects: vec![object.clone()], opaque: Vec::new(), mm_per_unit: 10.0 }, &desc);
+        let scene = render(&World { objects: vec![object], opaque: vec![floor], mm_per_unit: 10.0 }, &desc);
+        let path = common::output_dir().join(format!("{name}-on-checkers.png"));
+        translucent::output::write_image(&path, &scene, translucent::output::Exposure::Stops(0.0)).unwrap();
+        let (mut object_pixels, mut floor_values) = (0, Vec::new());
+        for (i, (p, q)) in scene.pixels.iter().zip(&alone.pixels).enumerate() {
+            if q[3] > 0.0 {
+                object_pixels += 1;
+                assert!(
+                    p.map(f32::to_bits) == q.map(f32::to_bits),
+                    "{name} pixel {i}: {p:?} on the floor, {q:?} alone"
+                );
+            } else if p[3] > 0.0 {
+                floor_values.push(p[0]);
+            }
+        }
+        assert!(object_pixels > 300, "{name}: {object_pixels}");
+        // Lit floor: ρ E / π for each square (f32 rounding aside); shadowed: 0.
+        let (lit_dark, lit_light) = (dark.x * e / std::f32::consts::PI, light.x * e / std::f32::consts::PI);
+        let count = |want: f32| floor_values.iter().filter(|&&v| (v - want).abs() <= 1e-5 * want).count();
+        let shadowed = floor_values.iter().filter(|&&v| v == 0.0).count();
+        let (d, l) = (count(lit_dark), count(lit_light));
+        assert!(d > 200 && l > 200, "{name}: both squares lit: {d} {l}");
+        assert!(shadowed > 30, "{name}: its shadow on the floor: {shadowed} pixels");
+        // Only the shadow's edge (the map's texels) lies in between.
+        let other = floor_values.len() - d - l - shadowed;
+        assert!(
+            other < floor_values.len() / 10,
+            "{name}: {other} of {} floor pixels neither lit nor in shadow",
+            floor_values.len()
+        );
+    }
 }
 
 /// A pbrt-v4 scene file and the same scene given by flags render the same image, bit for bit: a
