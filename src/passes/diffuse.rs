@@ -6,9 +6,8 @@
 
 use crate::error::Result;
 use crate::gpu::DiffuseConstants;
-use crate::passes::shade::COLOR_FORMAT;
 use crate::shadows::Shadows;
-use crate::vk::{self, Bind, Context, CullModeFlags, GraphicsDesc, Image, Pipeline, PrimitiveTopology, Recorder};
+use crate::vk::{self, Bind, Context, Image, Pipeline, Recorder};
 
 pub struct DiffusePass {
     pipeline: Pipeline,
@@ -16,23 +15,7 @@ pub struct DiffusePass {
 
 impl DiffusePass {
     pub fn new(ctx: &Context) -> Result<DiffusePass> {
-        let pipeline = Pipeline::graphics(
-            ctx,
-            &GraphicsDesc {
-                vertex_shader: "shade.vert",
-                fragment_shader: Some("diffuse.frag"),
-                vertex_stride: 0,
-                vertex_attributes: &[],
-                topology: PrimitiveTopology::TRIANGLE_LIST,
-                color_formats: &[COLOR_FORMAT],
-                depth_format: None,
-                depth_test: false,
-                depth_bias: false,
-                cull_mode: CullModeFlags::NONE,
-                additive_blend: false,
-                specialization: &[],
-            },
-        )?;
+        let pipeline = crate::passes::shade::full_screen_pipeline(ctx, "diffuse.frag", false, &[])?;
         Ok(DiffusePass { pipeline })
     }
 

@@ -111,12 +111,19 @@ pub struct ShadePass {
 /// Bytes per vertex: position and normal, 3 floats each.
 const VERTEX_STRIDE: u32 = 24;
 
-fn shading_pipeline(ctx: &Context, model: Model, additive_blend: bool) -> Result<Pipeline> {
+/// A full-screen triangle (`shade.vert`) running `fragment_shader` over the colour target: the
+/// shade pass, and the diffuse pass of opaque objects.
+pub fn full_screen_pipeline(
+    ctx: &Context,
+    fragment_shader: &str,
+    additive_blend: bool,
+    specialization: &[u32],
+) -> Result<Pipeline> {
     Pipeline::graphics(
         ctx,
         &GraphicsDesc {
             vertex_shader: "shade.vert",
-            fragment_shader: Some("shade.frag"),
+            fragment_shader: Some(fragment_shader),
             vertex_stride: 0,
             vertex_attributes: &[],
             topology: PrimitiveTopology::TRIANGLE_LIST,
@@ -126,47 +133,41 @@ fn shading_pipeline(ctx: &Context, model: Model, additive_blend: bool) -> Result
             depth_bias: false,
             cull_mode: CullModeFlags::NONE,
             additive_blend,
-            specialization: &[model.gpu_code()],
+            specialization,
+        },
+    )
+}
+
+fn shading_pipeline(ctx: &Context, model: Model, additive_blend: bool) -> Result<Pipeline> {
+    full_screen_pipeline(ctx, "shade.frag", additive_blend, &[model.gpu_code()])
+}
+
+/// A mesh (positions and normals) to the G-buffer, depth-tested, through `vertex_shader` and
+/// `fragment_shader`.
+fn surface_pipeline(ctx: &Context, vertex_shader: &str, fragment_shader: &str) -> Result<Pipeline> {
+    Pipeline::graphics(
+        ctx,
+        &GraphicsDesc {
+            vertex_shader,
+            fragment_shader: Some(fragment_shader),
+            vertex_stride: VERTEX_STRIDE,
+            vertex_attributes: &[(0, Format::R32G32B32_SFLOAT, 0), (1, Format::R32G32B32_SFLOAT, 12)],
+            topology: PrimitiveTopology::TRIANGLE_LIST,
+            color_formats: &[SURFACE_FORMAT, SURFACE_FORMAT, SURFACE_FORMAT],
+            depth_format: Some(DEPTH_FORMAT),
+            depth_test: true,
+            depth_bias: false,
+            cull_mode: CullModeFlags::NONE,
+            additive_blend: false,
+            specialization: &[],
         },
     )
 }
 
 impl ShadePass {
     pub fn new(ctx: &Context) -> Result<ShadePass> {
-        let surface = Pipeline::graphics(
-            ctx,
-            &GraphicsDesc {
-                vertex_shader: "surface.vert",
-                fragment_shader: Some("surface.frag"),
-                vertex_stride: VERTEX_STRIDE,
-                vertex_attributes: &[(0, Format::R32G32B32_SFLOAT, 0), (1, Format::R32G32B32_SFLOAT, 12)],
-                topology: PrimitiveTopology::TRIANGLE_LIST,
-                color_formats: &[SURFACE_FORMAT, SURFACE_FORMAT, SURFACE_FORMAT],
-                depth_format: Some(DEPTH_FORMAT),
-                depth_test: true,
-                depth_bias: false,
-                cull_mode: CullModeFlags::NONE,
-                additive_blend: false,
-                specialization: &[],
-            },
-        )?;
-        let surface_diffuse = Pipeline::graphics(
-            ctx,
-            &GraphicsDesc {
-                vertex_shader: "surface_diffuse.vert",
-                fragment_shader: Some("surface_diffuse.frag"),
-                vertex_stride: VERTEX_STRIDE,
-                vertex_attributes: &[(0, Format::R32G32B32_SFLOAT, 0), (1, Format::R32G32B32_SFLOAT, 12)],
-                topology: PrimitiveTopology::TRIANGLE_LIST,
-                color_formats: &[SURFACE_FORMAT, SURFACE_FORMAT, SURFACE_FORMAT],
-                depth_format: Some(DEPTH_FORMAT),
-                depth_test: true,
-                depth_bias: false,
-                cull_mode: CullModeFlags::NONE,
-                additive_blend: false,
-                specialization: &[],
-            },
-        )?;
+        let surface = surface_pipeline(ctx, "surface.vert", "surface.frag")?;
+        let surface_diffuse = surface_pipeline(ctx, "surface_diffuse.vert", "surface_diffuse.frag")?;
         Ok(ShadePass { surface, surface_diffuse, shading: HashMap::new() })
     }
 
