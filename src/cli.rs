@@ -92,7 +92,7 @@ pub struct MitsubaArgs {
     pub render: RenderArgs,
 }
 
-#[derive(Args, Debug)]
+#[derive(Args, Debug, Clone)]
 pub struct ViewArgs {
     #[command(flatten)]
     pub render: RenderArgs,

@@ -461,3 +461,49 @@ fn keys_pressed_while_a_preview_shades_end_in_the_image_of_the_same_settings() {
     assert_ok("keys-reference", &view("keys-reference", &args, &lines.each_ref().map(|l| l.as_str())));
     assert!(load(&shot) == load(&reference), "the last image differs from the same settings given at the start");
 }
+
+/// `view SCENE.pbrt` reads the scene as `render` does: the window takes the film's size, and its
+/// screenshot equals `render SCENE.pbrt` (a translucent sphere on an opaque checker floor).
+#[test]
+fn a_scene_file_in_the_viewer_equals_its_render() {
+    if !have_xvfb() {
+        return;
+    }
+    let dir = output_dir().join("view-scene");
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = r#"LookAt 0 2.5 5  0 0.4 0  0 1 0
+Camera "perspective" "float fov" [ 40 ]
+Film "rgb" "integer xresolution" [ 120 ] "integer yresolution" [ 90 ]
+WorldBegin
+LightSource "distant" "point3 from" [ 0.3 1 0.2 ] "point3 to" [ 0 0 0 ] "rgb L" [ 2 2 2 ]
+AttributeBegin
+  Material "subsurface" "string name" "Skin1" "float scale" 10
+  Translate 0 0.8 0
+  Shape "sphere" "float radius" 0.8
+AttributeEnd
+Texture "checks" "spectrum" "checkerboard" "float uscale" [ 8 ] "float vscale" [ 8 ] "rgb tex1" [ .1 .1 .1 ] "rgb tex2" [ .8 .8 .8 ]
+Material "diffuse" "texture reflectance" "checks"
+Shape "trianglemesh" "integer indices" [ 0 2 1 0 3 2 ] "point3 P" [ -4 0 -4 4 0 -4 4 0 4 -4 0 4 ] "point2 uv" [ 0 0 1 0 1 1 0 1 ]
+"#;
+    let path = dir.join("scene.pbrt");
+    std::fs::write(&path, scene).unwrap();
+    let (shot, rendered) = (png("scene-file"), png("scene-file-render"));
+    let line = format!("screenshot {}", shot.display());
+    let args = [path.to_str().unwrap(), "--samples", "4096", "--exposure", "0", "--no-panel"];
+    assert_ok("scene-file", &view("scene-file", &args, &["frames 1", &line, "quit"]));
+    let out = translucent(&[
+        "render",
+        "--validation",
+        path.to_str().unwrap(),
+        "--samples",
+        "4096",
+        "--exposure",
+        "0",
+        "--out",
+        rendered.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let (a, b) = (load(&shot), load(&rendered));
+    assert_eq!((a.width(), a.height()), (120, 90), "the window takes the film's size");
+    assert!(a == b, "the viewer's screenshot differs from render's image");
+}

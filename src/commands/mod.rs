@@ -27,10 +27,6 @@ pub fn run(cli: Cli) -> Result<i32> {
         }
         Command::Bssrdf(args) => bssrdf::bssrdf(&args),
         Command::Profile(args) => profile::profile(&args),
-        // The positional scene file comes with the flattened render flags; view does not read it yet.
-        Command::View(args) if args.render.scene.is_some() => Err(crate::bad_input!(
-            "view: scene files are read by `translucent render SCENE.pbrt` only (not by view yet)"
-        )),
         Command::View(args) => crate::view::run(&args),
         Command::Bench(args) => bench(&args),
         Command::Compare(args) => compare::compare(&args),

@@ -66,7 +66,18 @@ pub fn run(args: &ViewArgs) -> Result<i32> {
         Some(p) => controls::load_script(p)?,
         None => Vec::new(),
     };
-    let settings = RenderSettings::from_args(&args.render)?;
+    // A scene file (`view SCENE.pbrt`) as `render` reads it: its film is the window's size.
+    let from_scene;
+    let (args, settings) = match &args.render.scene {
+        Some(scene) => {
+            let argv: Vec<String> = std::env::args().collect();
+            let (render, settings) =
+                crate::pbrt::render_settings(scene, &args.render, &|f| crate::pbrt::flag_given(&argv, f))?;
+            from_scene = ViewArgs { render, ..args.clone() };
+            (&from_scene, settings)
+        }
+        None => (args, RenderSettings::from_args(&args.render)?),
+    };
     if !has_window_system() {
         return Err(no_window_system("neither DISPLAY nor WAYLAND_DISPLAY is set"));
     }
