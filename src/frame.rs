@@ -518,6 +518,7 @@ impl Renderer {
                 indices: &o.indices,
                 index_count: o.index_count,
                 uvs: &o.uvs,
+                texture: (&o.texture, &o.sampler),
                 constants: o.surface_constants(view_projection, (objects + j) as u32),
             })
             .collect();

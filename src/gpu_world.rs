@@ -16,7 +16,9 @@ use crate::mesh::Mesh;
 use crate::physics::Diffusion;
 use crate::scene::Light;
 use crate::shadows::Shadows;
-use crate::vk::{self, Buffer, BufferUsageFlags, Context, MemoryLocation};
+use crate::vk::{
+    self, Buffer, BufferUsageFlags, Context, Extent2D, Format, Image, ImageUsageFlags, MemoryLocation, Sampler,
+};
 use crate::world::{Opaque, Reflectance, World};
 
 /// One object on the GPU.
@@ -52,6 +54,10 @@ pub struct GpuOpaque {
     pub index_count: u32,
     /// One uv per vertex (zeros when the mesh has none).
     pub uvs: Buffer,
+    /// The reflectance image (one white texel when the reflectance is not an image), and its
+    /// repeating sampler.
+    pub texture: Image,
+    pub sampler: Sampler,
     pub bounds: (Vec3, Vec3),
     /// What it was made from.
     pub made_from: Opaque,
@@ -66,7 +72,36 @@ impl GpuOpaque {
             None => vec![[0.0; 2]; mesh.positions.len()],
         };
         let uvs = vk::upload_buffer(ctx, "uvs", &uvs, BufferUsageFlags::STORAGE_BUFFER)?;
-        Ok(GpuOpaque { vertices, indices, index_count, uvs, bounds: mesh.bounds(), made_from: opaque.clone() })
+        let white = [[1.0f32; 4]];
+        let (width, height, texels) = match &opaque.reflectance {
+            Reflectance::Image(t) => (t.width, t.height, t.texels.as_slice()),
+            _ => (1, 1, &white[..]),
+        };
+        let max = ctx.limits().max_image_dimension2_d;
+        if width > max || height > max {
+            return Err(bad_input!("texture {width}x{height}: this device allows at most {max} texels a side"));
+        }
+        let usage = ImageUsageFlags::SAMPLED | ImageUsageFlags::TRANSFER_DST;
+        let texture = Image::new_2d(
+            ctx,
+            "reflectance texture",
+            Format::R32G32B32A32_SFLOAT,
+            Extent2D { width, height },
+            1,
+            usage,
+        )?;
+        let mut staging = Buffer::new(
+            ctx,
+            "reflectance texture (staging)",
+            std::mem::size_of_val(texels) as u64,
+            BufferUsageFlags::TRANSFER_SRC,
+            MemoryLocation::CpuToGpu,
+        )?;
+        staging.write(0, texels)?;
+        ctx.submit(None, |rec| rec.copy_buffer_to_image(&staging, &texture))?;
+        let sampler = Sampler::repeating(ctx)?;
+        let bounds = mesh.bounds();
+        Ok(GpuOpaque { vertices, indices, index_count, uvs, texture, sampler, bounds, made_from: opaque.clone() })
     }
 
     /// Its draw into the G-buffer as object `id`, seen through `view_projection`.
@@ -74,6 +109,7 @@ impl GpuOpaque {
         let (tex1, tex2, checker) = match self.made_from.reflectance {
             Reflectance::Constant(c) => (c.extend(1.0), c.extend(1.0), 0),
             Reflectance::Checkerboard { uscale, vscale, tex1, tex2 } => (tex1.extend(uscale), tex2.extend(vscale), 1),
+            Reflectance::Image(_) => (glam::Vec4::ONE, glam::Vec4::ONE, 2),
         };
         DiffuseSurfaceConstants { view_projection, tex1, tex2, object: id, checker, pad: [0; 2] }
     }

@@ -73,6 +73,66 @@ pub enum Reflectance {
         tex1: Vec3,
         tex2: Vec3,
     },
+    /// An image over the mesh's uv (pbrt-v4's `imagemap`: v runs up the image), repeated,
+    /// filtered linearly.
+    Image(Texture),
+}
+
+/// An image of linear reflectances, rows from the top.
+#[derive(Clone, Debug)]
+pub struct Texture {
+    /// Where it came from, for messages.
+    pub name: String,
+    pub width: u32,
+    pub height: u32,
+    /// Linear RGB and 1, `width × height`.
+    pub texels: std::sync::Arc<Vec<[f32; 4]>>,
+}
+
+impl PartialEq for Texture {
+    fn eq(&self, other: &Texture) -> bool {
+        (self.width, self.height) == (other.width, other.height)
+            && (std::sync::Arc::ptr_eq(&self.texels, &other.texels) || self.texels == other.texels)
+    }
+}
+
+/// The largest texture side accepted (the device's image limit is checked when it is made).
+pub const MAX_TEXTURE_SIDE: u32 = 16384;
+
+impl Texture {
+    /// Reads a PNG (sRGB-encoded, decoded to linear) or an EXR (linear) file; `shown` names it in
+    /// messages. The size is read from the header before the image is decoded.
+    pub fn load(path: &std::path::Path, shown: &str) -> Result<Texture> {
+        let ext = path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).unwrap_or_default();
+        let meta = std::fs::metadata(path).map_err(|e| bad_input!("{shown}: {e}"))?;
+        if !meta.is_file() {
+            return Err(bad_input!("{shown}: not a regular file"));
+        }
+        let reader = image::ImageReader::open(path).map_err(|e| bad_input!("{shown}: {e}"))?;
+        let reader = reader.with_guessed_format().map_err(|e| bad_input!("{shown}: {e}"))?;
+        let (width, height) = reader.into_dimensions().map_err(|e| bad_input!("{shown}: not an image: {e}"))?;
+        if width == 0 || height == 0 || width > MAX_TEXTURE_SIDE || height > MAX_TEXTURE_SIDE {
+            return Err(bad_input!(
+                "{shown}: {width}x{height}: a texture's sides must be between 1 and {MAX_TEXTURE_SIDE}"
+            ));
+        }
+        let img = image::open(path).map_err(|e| bad_input!("{shown}: not an image: {e}"))?.into_rgba32f();
+        let linear = ext == "exr";
+        let decode = |c: f32| {
+            if linear {
+                c
+            } else if c <= 0.04045 {
+                c / 12.92
+            } else {
+                ((c + 0.055) / 1.055).powf(2.4)
+            }
+        };
+        let texels: Vec<[f32; 4]> = img.pixels().map(|p| [decode(p[0]), decode(p[1]), decode(p[2]), 1.0]).collect();
+        if let Some(t) = texels.iter().find(|t| !t[..3].iter().all(|c| c.is_finite() && (0.0..=1.0).contains(c))) {
+            return Err(bad_input!("{shown}: reflectance {:?}: every texel must be finite and within [0, 1]", &t[..3]));
+        }
+        Ok(Texture { name: shown.to_string(), width, height, texels: std::sync::Arc::new(texels) })
+    }
 }
 
 /// An opaque object: it reflects light (Lambertian) and casts shadows on every object; light
@@ -108,6 +168,12 @@ impl Opaque {
                     return Err(bad_input!("a checkerboard reflectance needs the mesh's uv coordinates"));
                 }
                 uscale.is_finite() && vscale.is_finite() && in_range(tex1) && in_range(tex2)
+            }
+            Reflectance::Image(ref t) => {
+                if self.uvs.is_none() {
+                    return Err(bad_input!("{}: an image reflectance needs the mesh's uv coordinates", t.name));
+                }
+                t.texels.len() == (t.width * t.height) as usize
             }
         };
         if !ok {

@@ -259,14 +259,13 @@ fn scenes_render_with_pbrts_handedness_and_flags_override() {
     assert_eq!(out.status.code(), Some(0), "{}", common::stderr(&out));
     let img = image::open(&out_png).unwrap();
     assert_eq!((img.width(), img.height()), (20, 24));
-    // What is not rendered yet is refused, naming the line (opaque shapes of constant and
-    // checkerboard reflectance render: tests/scenes.rs).
-    let image = "Texture \"img\" \"spectrum\" \"imagemap\" \"string filename\" \"x.png\"\nMaterial \"diffuse\" \"texture reflectance\" \"img\"\nShape \"sphere\"\n";
-    let opaque = write(&d, "opaque.pbrt", &(scene("", 0.0) + image));
-    let out = render(&[opaque.to_str().unwrap()]);
+    // What is not rendered yet is refused, naming the line (opaque shapes of constant,
+    // checkerboard and image reflectance render: tests/scenes.rs).
+    let infinite = write(&d, "infinite.pbrt", &(scene("", 0.0) + "LightSource \"infinite\" \"rgb L\" [ 1 1 1 ]\n"));
+    let out = render(&[infinite.to_str().unwrap()]);
     let err = common::stderr(&out);
     assert_eq!(out.status.code(), Some(2), "{err}");
-    assert!(err.contains("opaque.pbrt:14:1: ") && err.contains("not rendered yet"), "{err}");
+    assert!(err.contains("infinite.pbrt:12:1: ") && err.contains("not rendered yet"), "{err}");
     let spot = write(&d, "spot.pbrt", &(scene("", 0.0) + "LightSource \"spot\"\n"));
     let err = common::stderr(&render(&[spot.to_str().unwrap()]));
     assert!(err.contains("spot.pbrt:12:1: ") && err.contains("spot lights are not rendered yet"), "{err}");

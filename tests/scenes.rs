@@ -219,3 +219,78 @@ Shape "plymesh" "string filename" "torus.ply"
     let differing = a.pixels().zip(b.pixels()).filter(|(p, q)| p.0.map(f32::to_bits) != q.0.map(f32::to_bits)).count();
     assert_eq!(differing, 0, "pixels differing between the scene file and the flags");
 }
+
+/// pbrt-v4's `imagemap` on an opaque floor: an sRGB PNG of four quadrants (decoded to linear),
+/// over the shape's uv with v running up the image: each quadrant's lit floor is ρ E/π, and the
+/// quadrants land where pbrt puts them (u along +x, v along +z; the image's top row at v = 1).
+#[test]
+fn an_image_reflectance_on_a_floor() {
+    let dir = common::output_dir().join("imagemap");
+    std::fs::create_dir_all(&dir).unwrap();
+    // Top-left red, top-right green, bottom-left blue, bottom-right grey (128: 0.2158605 linear).
+    let img = image::RgbImage::from_fn(64, 64, |x, y| match (x < 32, y < 32) {
+        (true, true) => image::Rgb([255, 0, 0]),
+        (false, true) => image::Rgb([0, 255, 0]),
+        (true, false) => image::Rgb([0, 0, 255]),
+        (false, false) => image::Rgb([128, 128, 128]),
+    });
+    img.save(dir.join("quadrants.png")).unwrap();
+    let scene = r#"LookAt 0 6 4  0 0 0  0 1 0
+Camera "perspective" "float fov" [ 60 ]
+Film "rgb" "integer xresolution" [ 96 ] "integer yresolution" [ 96 ]
+WorldBegin
+LightSource "distant" "point3 from" [ 0 1 0 ] "point3 to" [ 0 0 0 ] "rgb L" [ 2 2 2 ]
+AttributeBegin
+  Material "subsurface" "string name" "Skin1" "float scale" 10
+  Translate 0 3 0
+  Shape "sphere" "float radius" 0.2
+AttributeEnd
+Texture "quads" "spectrum" "imagemap" "string filename" "quadrants.png"
+Material "diffuse" "texture reflectance" "quads"
+Shape "trianglemesh" "integer indices" [ 0 2 1 0 3 2 ] "point3 P" [ -4 0 -4 4 0 -4 4 0 4 -4 0 4 ] "point2 uv" [ 0 0 1 0 1 1 0 1 ]
+"#;
+    let path = dir.join("floor.pbrt");
+    std::fs::write(&path, scene).unwrap();
+    let exr = dir.join("floor.exr");
+    let out = common::translucent(&[
+        "render",
+        "--validation",
+        path.to_str().unwrap(),
+        "--samples",
+        "2000",
+        "--out",
+        exr.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", common::stderr(&out));
+    let img = image::open(&exr).unwrap().into_rgba32f();
+    let lit = 2.0 / std::f32::consts::PI;
+    let grey = 0.2158605 * lit;
+    let quadrants =
+        [("red", [lit, 0.0, 0.0]), ("green", [0.0, lit, 0.0]), ("blue", [0.0, 0.0, lit]), ("grey", [grey; 3])];
+    let mut found = Vec::new();
+    for (name, want) in quadrants {
+        let px: Vec<(u32, u32)> = img
+            .enumerate_pixels()
+            .filter(|(_, _, p)| (0..3).all(|c| (p[c] - want[c]).abs() <= 1e-4 * lit))
+            .map(|(x, y, _)| (x, y))
+            .collect();
+        assert!(px.len() > 200, "{name}: {} pixels of its lit reflectance", px.len());
+        let mean = |f: fn(&(u32, u32)) -> u32| px.iter().map(f).sum::<u32>() as f64 / px.len() as f64;
+        found.push((name, mean(|p| p.0), mean(|p| p.1)));
+    }
+    let (red, green, blue, grey) = (found[0], found[1], found[2], found[3]);
+    // The camera looks down −z from above +z, −z at the image's top; pbrt's camera x is
+    // LookAt's up × direction, world −x here, so −x (u < 0.5) is on the image's right in pbrt and here.
+    assert!(red.1 > 48.0 && blue.1 > 48.0 && green.1 < 48.0 && grey.1 < 48.0, "u along +x: {found:?}");
+    assert!(blue.2 < red.2 && grey.2 < green.2, "the image's bottom row at v = 0 (−z, far): {found:?}");
+    // A missing image, and one that is not an image: exit 2 naming the scene's line and the file.
+    std::fs::write(dir.join("garbage.png"), [0x89u8, b'P', b'N', b'G', 0, 1, 2, 3]).unwrap();
+    for (file, needle) in [("missing.png", "missing.png"), ("garbage.png", "not an image")] {
+        let bad = dir.join(format!("bad-{file}.pbrt"));
+        std::fs::write(&bad, scene.replace("quadrants.png", file)).unwrap();
+        let out = common::translucent(&["render", bad.to_str().unwrap(), "--out", exr.to_str().unwrap()]);
+        let err = common::stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{file}: {err}");
+        assert!(err.contains(&format!("bad-{file}.pbrt:13:1: ")) && err.contains(needle), "{file}: {err}");
+    }
+}

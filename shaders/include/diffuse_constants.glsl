@@ -8,7 +8,7 @@ layout(push_constant, std430) uniform DiffuseSurfaceConstants {
     vec4 tex1;        // rgb: reflectance (the checkerboard's first); w: uscale
     vec4 tex2;        // rgb: the checkerboard's second reflectance; w: vscale
     uint object;      // the G-buffer's id of this object (position w = object + 1)
-    uint checker;     // 1: a checkerboard over the mesh's uv, 0: tex1 everywhere
+    uint checker;     // 1: a checkerboard over the mesh's uv, 2: the image, 0: tex1 everywhere
     uint pad0;
     uint pad1;
 } pc;

@@ -38,7 +38,7 @@ pub struct DiffuseSurfaceConstants {
     pub tex2: Vec4,
     /// The object's G-buffer id (position w = object + 1).
     pub object: u32,
-    /// 1 for a checkerboard over the mesh's uv.
+    /// 1 for a checkerboard over the mesh's uv, 2 for its image, 0 for `tex1` everywhere.
     pub checker: u32,
     pub pad: [u32; 2],
 }

@@ -95,6 +95,8 @@ pub struct OpaqueDraw<'a> {
     pub index_count: u32,
     /// One uv per vertex.
     pub uvs: &'a Buffer,
+    /// Its reflectance image and sampler.
+    pub texture: (&'a Image, &'a Sampler),
     pub constants: DiffuseSurfaceConstants,
 }
 
@@ -202,7 +204,7 @@ impl ShadePass {
             rec.use_buffer(indices, vk::Access::INDEX_INPUT)?;
         }
         for o in opaque {
-            rec.prepare_draw_reads(&[Bind::Read(o.uvs)])?;
+            rec.prepare_draw_reads(&[Bind::Read(o.uvs), Bind::Sampled(o.texture.0, o.texture.1)])?;
         }
         let clear = Some([0.0; 4]);
         let targets = [(inputs.position, clear), (inputs.normal, clear), (inputs.albedo, clear)];
@@ -215,7 +217,7 @@ impl ShadePass {
         }
         for o in opaque {
             let (v, i) = (Some(o.vertices), Some(o.indices));
-            let binds = [Bind::Read(o.uvs)];
+            let binds = [Bind::Read(o.uvs), Bind::Sampled(o.texture.0, o.texture.1)];
             rec.draw(&self.surface_diffuse, &binds, vk::bytes_of(&o.constants), v, i, o.index_count, 1)?;
         }
         rec.end_rendering();

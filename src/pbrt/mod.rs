@@ -429,12 +429,9 @@ pub fn render_settings(
     let mut opaque_objects = Vec::new();
     for (o, reflectance) in opaque {
         let (mesh, uvs) = mesh_of(o)?;
-        if matches!(reflectance, crate::world::Reflectance::Checkerboard { .. }) && uvs.is_none() {
-            return Err(bad_input!(
-                "{}: Shape \"{}\": a checkerboard texture needs the shape's \"point2 uv\"",
-                o.loc,
-                o.shape
-            ));
+        let textured = !matches!(reflectance, crate::world::Reflectance::Constant(_));
+        if textured && uvs.is_none() {
+            return Err(bad_input!("{}: Shape \"{}\": a texture needs the shape's \"point2 uv\"", o.loc, o.shape));
         }
         opaque_objects.push(crate::world::Opaque { uvs, ..crate::world::Opaque::new(mesh, reflectance) });
     }
@@ -528,7 +525,8 @@ fn reflectance_of(r: &Reflectance, loc: &Loc) -> Result<crate::world::Reflectanc
             _ => Err(bad_input!("{loc}: a checkerboard of textures (not of two constants) is not rendered yet")),
         },
         Reflectance::ImageMap { path } => {
-            Err(bad_input!("{loc}: \"imagemap\" reflectance ({}) is not rendered yet", path.display()))
+            let shown = format!("{loc}: \"imagemap\" {}", path.display());
+            Ok(crate::world::Reflectance::Image(crate::world::Texture::load(path, &shown)?))
         }
     }
 }

@@ -326,6 +326,23 @@ impl Sampler {
     }
 }
 
+impl Sampler {
+    /// A linear sampler that repeats its image (textures over a mesh's uv).
+    pub fn repeating(ctx: &Context) -> Result<Sampler> {
+        let info = vk::SamplerCreateInfo::default()
+            .mag_filter(vk::Filter::LINEAR)
+            .min_filter(vk::Filter::LINEAR)
+            .mipmap_mode(vk::SamplerMipmapMode::NEAREST)
+            .address_mode_u(vk::SamplerAddressMode::REPEAT)
+            .address_mode_v(vk::SamplerAddressMode::REPEAT)
+            .address_mode_w(vk::SamplerAddressMode::REPEAT)
+            .max_lod(0.0);
+        // SAFETY: valid device.
+        let raw = unsafe { ctx.device().create_sampler(&info, None) }.map_err(|e| runtime!("vkCreateSampler: {e}"))?;
+        Ok(Sampler { shared: ctx.shared.clone(), raw })
+    }
+}
+
 impl Drop for Sampler {
     fn drop(&mut self) {
         unsafe { self.shared.device.destroy_sampler(self.raw, None) };
