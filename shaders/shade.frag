@@ -31,7 +31,9 @@ layout(binding = 1) uniform usamplerBuffer nodes;
 layout(binding = 2) uniform usamplerBuffer points;
 // Work per pixel for --profile: sums and maxima of nodes visited and points evaluated.
 // Sd evaluations: calls of source(), each for three channels (a node used whole is two per light).
-layout(std430, binding = 3) buffer WorkCounters { uint pixels; uint node_sum; uint node_max; uint point_sum; uint point_max; uint evaluation_sum; } work;
+// One record per translucent object, indexed by the object shaded.
+struct WorkCounters { uint pixels; uint node_sum; uint node_max; uint point_sum; uint point_max; uint evaluation_sum; };
+layout(std430, binding = 3) buffer Work { WorkCounters objects[]; } work;
 layout(std430, binding = 4) readonly buffer Lights { LightSet light_set; mat4 layer_matrices[]; };
 layout(binding = 5) uniform sampler2DArrayShadow shadow_map;
 // Per-light records as texels: PointLight (sorted), NodeLight.
@@ -272,15 +274,15 @@ void main() {
         // Brute-force draws after the first add their points only.
         bool brute_force = frame_params.brute_force != 0u || object_params.node_count == 0u;
         if (pc.point_range.x == 0u) {
-            atomicAdd(work.pixels, 1u);
-            atomicAdd(work.node_sum, visits);
-            atomicMax(work.node_max, visits);
+            atomicAdd(work.objects[pc.point_range.z].pixels, 1u);
+            atomicAdd(work.objects[pc.point_range.z].node_sum, visits);
+            atomicMax(work.objects[pc.point_range.z].node_max, visits);
             // A brute-force pixel's points span several draws: its maximum is all of them (the
             // measured sum over the draws checks it).
-            atomicMax(work.point_max, brute_force ? object_params.point_count * light_count : evaluated);
+            atomicMax(work.objects[pc.point_range.z].point_max, brute_force ? object_params.point_count * light_count : evaluated);
         }
-        atomicAdd(work.point_sum, evaluated);
-        atomicAdd(work.evaluation_sum, evaluations);
+        atomicAdd(work.objects[pc.point_range.z].point_sum, evaluated);
+        atomicAdd(work.objects[pc.point_range.z].evaluation_sum, evaluations);
     }
     float cos_o = max(dot(no, wo), 0.0);
     vec3 lo = fresnel_transmittance(object_params.channels[0].eta, cos_o) * sum;

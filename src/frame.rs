@@ -159,13 +159,7 @@ impl Renderer {
             BufferUsageFlags::STORAGE_BUFFER | BufferUsageFlags::TRANSFER_DST,
             MemoryLocation::GpuOnly,
         )?;
-        let work_counters = Buffer::new(
-            &ctx,
-            "work counters",
-            std::mem::size_of::<WorkCounters>() as u64,
-            BufferUsageFlags::STORAGE_BUFFER | BufferUsageFlags::TRANSFER_DST,
-            MemoryLocation::GpuToCpu,
-        )?;
+        let work_counters = work_counters(&ctx, std::mem::size_of::<WorkCounters>() as u64)?;
         let frame_params = Buffer::new(
             &ctx,
             "frame parameters",
@@ -277,9 +271,15 @@ impl Renderer {
         frames as u64 * 1000
     }
 
-    /// Work of the last frame's shading per pixel (zeros unless it counted work).
+    /// Work of the last frame's shading per pixel, every object's together (zeros unless it
+    /// counted work).
     pub fn work(&self) -> Result<WorkCounters> {
-        Ok(self.work_counters.read::<WorkCounters>(1)?[0])
+        Ok(WorkCounters::combined(&self.work_per_object()?))
+    }
+
+    /// The same per translucent object, in the world's order.
+    pub fn work_per_object(&self) -> Result<Vec<WorkCounters>> {
+        self.work_counters.read::<WorkCounters>(self.world.objects.len().max(1))
     }
 
     /// The last frame tone-mapped on the GPU (exposure, filmic curve, sRGB; alpha = coverage).
@@ -477,6 +477,12 @@ impl Renderer {
         world.validate()?;
         self.world.sync(&self.ctx, world, desc)?;
         self.fit_targets(desc.width, desc.height)?;
+        // A work record per object.
+        let work_bytes = (self.world.objects.len() * std::mem::size_of::<WorkCounters>()) as u64;
+        if self.work_counters.size < work_bytes {
+            self.ctx.wait_idle()?;
+            self.work_counters = work_counters(&self.ctx, work_bytes)?;
+        }
         // Tile lists for each object (made again with the targets, or for a new object).
         self.tile_lists.truncate(self.world.objects.len());
         while self.tile_lists.len() < self.world.objects.len() {
@@ -683,6 +689,12 @@ impl Renderer {
         self.check_finite()?;
         Ok(self.profiler.as_mut().map(|p| p.take_scopes()).unwrap_or_default())
     }
+}
+
+/// The work counters' buffer (`bytes`: a record per object), read by the host.
+fn work_counters(ctx: &Context, bytes: u64) -> Result<Buffer> {
+    let usage = BufferUsageFlags::STORAGE_BUFFER | BufferUsageFlags::TRANSFER_DST;
+    Buffer::new(ctx, "work counters", bytes, usage, MemoryLocation::GpuToCpu)
 }
 
 /// The images and buffers whose size is the frame's.

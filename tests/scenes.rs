@@ -294,3 +294,34 @@ Shape "trianglemesh" "integer indices" [ 0 2 1 0 3 2 ] "point3 P" [ -4 0 -4 4 0 
         assert!(err.contains(&format!("bad-{file}.pbrt:13:1: ")) && err.contains(needle), "{file}: {err}");
     }
 }
+
+/// `--profile`'s work counters per object: each object's pixel count is the pixels it covers,
+/// and the frame's counters are theirs together.
+#[test]
+fn work_is_counted_per_object() {
+    let sphere = placed(Mesh::sphere(0.8, 24), "marble", Vec3::new(-1.1, 0.0, 0.0), 4096);
+    let torus = placed(Mesh::torus(0.6, 0.25, 32, 16), "skin1", Vec3::new(1.1, 0.0, 0.0), 3000);
+    let camera = Camera { eye: Vec3::new(0.0, 0.6, 5.0), target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 45.0 };
+    let light = Light::Directional { toward: Vec3::Y, irradiance: Vec3::ONE };
+    let mut desc = FrameDesc::new(camera, vec![light]);
+    (desc.width, desc.height, desc.count_work) = (96, 48, true);
+    let world = World { objects: vec![sphere.clone(), torus.clone()], opaque: Vec::new(), mm_per_unit: 10.0 };
+    let (ctx, counts) = common::validated_context();
+    let mut renderer = Renderer::new(ctx, false).unwrap();
+    renderer.render_frame(&world, &desc).unwrap();
+    let (per_object, all, image) =
+        (renderer.work_per_object().unwrap(), renderer.work().unwrap(), renderer.image().unwrap());
+    drop(renderer);
+    common::assert_clean(&counts);
+    let alone: Vec<usize> = [sphere, torus]
+        .into_iter()
+        .map(|o| {
+            let img = render(&World { objects: vec![o], opaque: Vec::new(), mm_per_unit: 10.0 }, &desc);
+            img.pixels.iter().filter(|p| p[3] > 0.0).count()
+        })
+        .collect();
+    assert_eq!(per_object.iter().map(|w| w.pixels as usize).collect::<Vec<_>>(), alone);
+    assert_eq!(all.pixels as usize, image.pixels.iter().filter(|p| p[3] > 0.0).count());
+    assert_eq!(all.point_sum, per_object[0].point_sum + per_object[1].point_sum);
+    assert!(per_object.iter().all(|w| w.evaluation_sum > 0));
+}

@@ -71,6 +71,7 @@ fn render_settings(args: &RenderArgs, settings: RenderSettings) -> Result<i32> {
         crate::note!("wrote {} ({}x{}, {} frame(s))", args.out.display(), args.width, args.height, args.frames);
     }
     let work = renderer.work()?;
+    let per_object = renderer.work_per_object()?;
     drop(renderer);
 
     if frames.iter().any(|f| !f.is_empty()) {
@@ -92,6 +93,20 @@ fn render_settings(args: &RenderArgs, settings: RenderSettings) -> Result<i32> {
             work.point_max,
             per_pixel(work.evaluation_sum)
         ))?;
+        if per_object.len() > 1 {
+            for (k, w) in per_object.iter().enumerate() {
+                let px = w.pixels.max(1) as f64;
+                crate::error::write_stdout(&format!(
+                    "  object {k} ({} pixels): nodes visited mean {:.1} max {}, points evaluated mean {:.1} max {}, Sd evaluations mean {:.1}\n",
+                    w.pixels,
+                    w.node_sum as f64 / px,
+                    w.node_max,
+                    w.point_sum as f64 / px,
+                    w.point_max,
+                    w.evaluation_sum as f64 / px
+                ))?;
+            }
+        }
     }
     Ok(counts.exit_code(validating))
 }

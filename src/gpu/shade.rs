@@ -15,7 +15,7 @@ pub struct ShadeConstants {
 
 /// Mirrors `WorkCounters` in shaders/shade.frag.
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
 pub struct WorkCounters {
     pub pixels: u32,
     pub node_sum: u32,
@@ -24,6 +24,20 @@ pub struct WorkCounters {
     pub point_max: u32,
     /// Sd evaluations (three channels each): a point is one per light, a node used whole two.
     pub evaluation_sum: u32,
+}
+
+impl WorkCounters {
+    /// The work of several objects' pixels together: sums added, maxima the largest.
+    pub fn combined(all: &[WorkCounters]) -> WorkCounters {
+        all.iter().fold(WorkCounters::default(), |a, w| WorkCounters {
+            pixels: a.pixels + w.pixels,
+            node_sum: a.node_sum + w.node_sum,
+            node_max: a.node_max.max(w.node_max),
+            point_sum: a.point_sum + w.point_sum,
+            point_max: a.point_max.max(w.point_max),
+            evaluation_sum: a.evaluation_sum + w.evaluation_sum,
+        })
+    }
 }
 
 /// Mirrors `DiffuseSurfaceConstants` in shaders/include/diffuse_constants.glsl: an opaque
