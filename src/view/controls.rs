@@ -310,6 +310,14 @@ pub fn turn_lights(lights: &mut [Light], camera: &Camera, centre: Vec3, right_de
             Light::Point { position, intensity } => {
                 Light::Point { position: centre + turn * (position - centre), intensity }
             }
+            // The position turns about the centre and the axis with it, as if carried rigidly.
+            Light::Spot { position, axis, intensity, cone_deg, delta_deg } => Light::Spot {
+                position: centre + turn * (position - centre),
+                axis: (turn * axis).normalize(),
+                intensity,
+                cone_deg,
+                delta_deg,
+            },
         };
     }
 }
