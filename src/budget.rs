@@ -13,7 +13,8 @@ pub struct FrameSizes {
     pub width: u32,
     pub height: u32,
     pub shadow_resolution: u32,
-    /// Shadow-map layers: one per directional light, six per point light (at least 2).
+    /// Shadow-map layers: one per directional light and spot light, six per point light and spot
+    /// wider than [`crate::scene::SPOT_CUBE_ABOVE_DEG`] (at least 2).
     pub shadow_layers: u32,
     pub point_count: u32,
     /// Lights: each has its own record per point and node.
@@ -22,7 +23,7 @@ pub struct FrameSizes {
 
 impl FrameSizes {
     pub fn shadow_layers(lights: &[Light]) -> u32 {
-        lights.iter().map(|l| if matches!(l, Light::Point { .. }) { 6 } else { 1 }).sum::<u32>().max(2)
+        lights.iter().map(Light::shadow_layers).sum::<u32>().max(2)
     }
 }
 

@@ -327,14 +327,18 @@ pub struct RenderArgs {
     #[arg(long, allow_hyphen_values = true, value_parser = rgb, value_name = "I|R,G,B", default_value = "1")]
     pub light_intensity: Vec3,
     /// A light (repeatable, up to 8; replaces the default light): `dir:X,Y,Z[:I]` (direction toward
-    /// the light; I = irradiance at normal incidence, one value or R,G,B) or `point:X,Y,Z[:I]`
-    /// (position; I = radiant intensity, falling off with the squared distance).
-    #[arg(long = "light", value_parser = light_spec, value_name = "dir:X,Y,Z[:I] | point:X,Y,Z[:I]")]
+    /// the light; I = irradiance at normal incidence, one value or R,G,B), `point:X,Y,Z[:I]`
+    /// (position; I = radiant intensity, falling off with the squared distance) or
+    /// `spot:X,Y,Z:TX,TY,TZ:ANGLE[:DELTA[:I]]` (a point light at X,Y,Z aimed at TX,TY,TZ, lighting a
+    /// cone of ANGLE degrees from its axis, in (0, 180]; its intensity falls to 0 over the cone's
+    /// outer DELTA degrees, in [0, ANGLE], default 5 (pbrt-v4's spot: a smoothstep in cos θ); I =
+    /// radiant intensity along the axis).
+    #[arg(long = "light", value_parser = light_spec, value_name = "dir:X,Y,Z[:I] | point:X,Y,Z[:I] | spot:X,Y,Z:TX,TY,TZ:ANGLE[:DELTA[:I]]")]
     pub lights: Vec<Light>,
     /// Sample points on the surface (default: from the material's diffusion length and the mesh's area).
     #[arg(long, allow_hyphen_values = true, value_parser = clap::value_parser!(u32))]
     pub samples: Option<u32>,
-    /// Shadow-map resolution per light (per cube face for point lights).
+    /// Shadow-map resolution per light (per cube face for point lights and spots wider than 60°).
     #[arg(long, allow_hyphen_values = true, default_value_t = crate::frame_desc::DEFAULT_SHADOW_RESOLUTION, value_parser = clap::value_parser!(u32).range(16..=8192))]
     pub shadow_resolution: u32,
     /// Draw a debug view over the mesh: the sample points or the tree's boxes at --level.
@@ -393,10 +397,19 @@ pub(crate) fn triple(s: &str) -> std::result::Result<[f64; 3], String> {
     }
 }
 
+/// The forms of `--light` (and of the viewer's `light` lines).
+pub(crate) const LIGHT_FORMS: &str = "dir:X,Y,Z[:I], point:X,Y,Z[:I] or spot:X,Y,Z:TX,TY,TZ:ANGLE[:DELTA[:I]]";
+
+/// A spot light's falloff width when `spot:` leaves it out: pbrt-v4's `conedeltaangle` default.
+pub const SPOT_DEFAULT_DELTA_DEG: f32 = 5.0;
+
 pub(crate) fn light_spec(s: &str) -> std::result::Result<Light, String> {
+    if let Some(rest) = s.strip_prefix("spot:") {
+        return spot_spec(s, rest);
+    }
     let mut parts = s.splitn(3, ':');
     let kind = parts.next().unwrap_or("");
-    let at = parts.next().ok_or_else(|| format!("'{s}': expected dir:X,Y,Z[:I] or point:X,Y,Z[:I]"))?;
+    let at = parts.next().ok_or_else(|| format!("'{s}': expected {LIGHT_FORMS}"))?;
     let v = vec3(at)?;
     let intensity = parts.next().map(rgb).transpose()?.unwrap_or(Vec3::ONE);
     let light = match kind {
@@ -405,10 +418,29 @@ pub(crate) fn light_spec(s: &str) -> std::result::Result<Light, String> {
             irradiance: intensity,
         },
         "point" => Light::Point { position: v, intensity },
-        _ => return Err(format!("'{s}': the kind must be dir or point, not '{kind}'")),
+        _ => return Err(format!("'{s}': the kind must be dir, point or spot, not '{kind}'")),
     };
     light.validate().map_err(|e| e.to_string())?;
     Ok(light)
+}
+
+/// `spot:X,Y,Z:TX,TY,TZ:ANGLE[:DELTA[:I]]`: the position, the point it is aimed at, the cone's
+/// half-angle in degrees (0, 180], the falloff's width inside its edge in degrees [0, ANGLE]
+/// (default pbrt's 5°, or ANGLE when that is smaller) and the intensity along the axis.
+fn spot_spec(s: &str, rest: &str) -> std::result::Result<Light, String> {
+    let parts: Vec<&str> = rest.split(':').collect();
+    if !(3..=5).contains(&parts.len()) {
+        return Err(format!("'{s}': expected spot:X,Y,Z:TX,TY,TZ:ANGLE[:DELTA[:I]]"));
+    }
+    let position = vec3(parts[0])?;
+    let target = vec3(parts[1])?;
+    let cone = finite_f32(parts[2]).map_err(|e| format!("'{s}': cone angle: {e}"))?;
+    let delta = match parts.get(3) {
+        Some(d) => finite_f32(d).map_err(|e| format!("'{s}': falloff width: {e}"))?,
+        None => SPOT_DEFAULT_DELTA_DEG.min(cone.max(0.0)),
+    };
+    let intensity = parts.get(4).map(|i| rgb(i)).transpose()?.unwrap_or(Vec3::ONE);
+    Light::spot(position, target, cone, delta, intensity).map_err(|e| format!("'{s}': {e}"))
 }
 
 pub(crate) fn finite_f32(s: &str) -> std::result::Result<f32, String> {

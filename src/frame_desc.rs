@@ -139,13 +139,14 @@ pub fn check_camera(camera: &Camera) -> Result<()> {
     camera.validate()
 }
 
-/// Between 1 and [`crate::gpu::MAX_LIGHTS`] lights, each valid, point lights within
+/// Between 1 and [`crate::gpu::MAX_LIGHTS`] lights, each valid, point and spot lights within
 /// [`MAX_COORDINATE`].
 pub fn check_lights(lights: &[Light]) -> Result<()> {
     for light in lights {
-        if let Light::Point { position, .. } = light {
+        if let Some(position) = light.position() {
             if position.abs().max_element() > MAX_COORDINATE {
-                return Err(bad_input!("--light point:{position}: coordinates must be within ±{MAX_COORDINATE:e}"));
+                let kind = if matches!(light, Light::Spot { .. }) { "spot" } else { "point" };
+                return Err(bad_input!("--light {kind}:{position}: coordinates must be within ±{MAX_COORDINATE:e}"));
             }
         }
     }

@@ -199,9 +199,10 @@ impl Hierarchy {
             return Err(runtime!("{} lights given, the hierarchy was made for {}", lights.len(), self.light_count));
         }
         for light in lights {
-            if let Light::Point { position, .. } = light {
-                if mesh.contains_point(*position) {
-                    return Err(bad_input!("point light at {position} is inside the mesh: it would light nothing"));
+            if let Some(position) = light.position() {
+                if mesh.contains_point(position) {
+                    let kind = if matches!(light, Light::Spot { .. }) { "spot" } else { "point" };
+                    return Err(bad_input!("{kind} light at {position} is inside the mesh: it would light nothing"));
                 }
             }
         }

@@ -161,7 +161,7 @@ pub(crate) fn rescaled(mut scene: Scene, radius: f32) -> Scene {
     scene.camera.eye *= factor;
     scene.camera.target *= factor;
     for light in &mut scene.lights {
-        if let Light::Point { position, .. } = light {
+        if let Some(position) = light.position_mut() {
             *position *= factor;
         }
     }

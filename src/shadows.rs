@@ -32,7 +32,7 @@ impl Shadows {
         if lights.is_empty() || lights.len() > MAX_LIGHTS {
             return Err(bad_input!("between 1 and {MAX_LIGHTS} lights are supported, {} given", lights.len()));
         }
-        let layers: u32 = lights.iter().map(|l| if matches!(l, Light::Point { .. }) { 6 } else { 1 }).sum();
+        let layers: u32 = lights.iter().map(Light::shadow_layers).sum();
         Ok(Shadows {
             lights: Buffer::new(
                 ctx,
@@ -76,12 +76,25 @@ impl Shadows {
         self.layer_matrices.clear();
         for (k, light) in lights.iter().enumerate() {
             light.validate()?;
-            let (position, intensity) = match *light {
-                Light::Directional { toward, irradiance } => (toward.normalize().extend(0.0), irradiance.extend(0.0)),
-                Light::Point { position, intensity } => (position.extend(1.0), intensity.extend(0.0)),
+            let mut gpu = GpuLight {
+                first_layer: self.layer_matrices.len() as u32,
+                cube: (light.shadow_layers() == 6) as u32,
+                ..GpuLight::default()
             };
-            header.lights[k] =
-                GpuLight { position, intensity, first_layer: self.layer_matrices.len() as u32, pad: [0; 3] };
+            match *light {
+                Light::Directional { toward, irradiance } => {
+                    (gpu.position, gpu.intensity) = (toward.normalize().extend(0.0), irradiance.extend(0.0))
+                }
+                Light::Point { position, intensity } => {
+                    (gpu.position, gpu.intensity) = (position.extend(1.0), intensity.extend(0.0))
+                }
+                Light::Spot { position, axis, intensity, cone_deg, delta_deg } => {
+                    let (cos_total, cos_start) = Light::spot_cosines(cone_deg, delta_deg);
+                    (gpu.position, gpu.intensity) = (position.extend(1.0), intensity.extend(0.0));
+                    (gpu.axis, gpu.cos_falloff_start, gpu.spot) = (axis.extend(cos_total), cos_start, 1);
+                }
+            }
+            header.lights[k] = gpu;
             self.layer_matrices.extend(shadow::light_matrices(light, centre, radius, self.casters));
         }
         if self.layer_matrices.len() as u32 > self.shadow_map.layers {

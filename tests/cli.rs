@@ -99,10 +99,38 @@ fn bad_hierarchy_input() {
     assert_bad_input(&["--light", "point:0,0,0:5"], "inside the mesh");
     assert_bad_input(&["--light", "dir:nan,1,0"], "--light");
     assert_bad_input(&["--light", "point:1,nan,0"], "--light");
-    assert_bad_input(&["--light", "spot:1,1,1"], "kind must be dir or point");
+    assert_bad_input(&["--light", "spot:1,1,1"], "expected spot:X,Y,Z:TX,TY,TZ:ANGLE[:DELTA[:I]]");
+    assert_bad_input(&["--light", "cone:1,1,1"], "kind must be dir, point or spot");
     assert_bad_input(&["--light", "dir:0,1,0:-2"], "--light");
     let nine: Vec<&str> = (0..9).flat_map(|_| ["--light", "dir:0,1,0"]).collect();
     assert_bad_input(&nine, "at most 8 lights");
+}
+
+/// `--light spot:…` refuses each part that is out of range, naming the flag and the value.
+#[test]
+fn bad_spot_lights() {
+    for (spec, needle) in [
+        ("spot:0,3,0:0,0,0:0", "cone angle 0°: must be in (0, 180]"),
+        ("spot:0,3,0:0,0,0:-10", "cone angle -10°"),
+        ("spot:0,3,0:0,0,0:180.5", "cone angle 180.5°"),
+        ("spot:0,3,0:0,0,0:30:40", "falloff width 40°: must be in [0, 30]"),
+        ("spot:0,3,0:0,0,0:30:-1", "falloff width -1°"),
+        ("spot:0,3,0:0,3,0:30", "are the same point"),
+        ("spot:0,nan,0:0,0,0:30", "'nan' is not finite"),
+        ("spot:0,3,0:0,0,inf:30", "'inf' is not finite"),
+        ("spot:0,3,0:0,0,0:inf", "cone angle: 'inf' is not finite"),
+        ("spot:0,3,0:0,0,0:30:5:-1", "must not be negative"),
+        ("spot:0,3,0:0,0,0:30:5:1:2", "expected spot:X,Y,Z"),
+        ("spot:0,3,0:0,0:30", "X,Y,Z"),
+        ("spot:1e16,0,0:0,0,0:30", "coordinates must be within"),
+    ] {
+        // Each names the flag (clap's "invalid value … for '--light …'", or check_lights').
+        assert_bad_input(&["--light", spec], needle);
+        let out = translucent(&["render", "--mesh", "sphere", "--light", spec]);
+        assert!(stderr(&out).starts_with("error:") && stderr(&out).contains("--light"), "{spec}: {}", stderr(&out));
+    }
+    // Found once the mesh is known: the light is inside it.
+    assert_bad_input(&["--light", "spot:0,0,0:0,1,0:30"], "spot light at [0, 0, 0] is inside the mesh");
 }
 
 #[test]

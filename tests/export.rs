@@ -167,6 +167,36 @@ fn point_lights_and_the_default_camera_are_in_millimetres() {
     assert_eq!(attr(&xml, "<bsdf type=\"dielectric\"", "name=\"int_ior\"", "value"), "1.5");
 }
 
+/// A spot light: Mitsuba's `spot` at the position in mm, looking along the axis, its cutoff the
+/// cone angle and its beam the cone less the falloff width; a warning says that the two falloffs
+/// differ over that rim.
+#[test]
+fn spot_lights_are_mitsubas_spot_emitters() {
+    let dir = output_dir().join("export-spot");
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = translucent(&[
+        "export",
+        "mitsuba",
+        "--out",
+        dir.to_str().unwrap(),
+        "--mesh",
+        "box",
+        "--scale",
+        "4",
+        "--light",
+        "spot:0,3,0:0,0,0:30:5:2",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(err.contains("spot") && err.contains("smoothstep in cos θ"), "the falloff warned about: {err}");
+    let xml = std::fs::read_to_string(dir.join("scene.xml")).unwrap();
+    assert_eq!(numbers(&attr(&xml, "<emitter type=\"spot\"", "<lookat", "origin")), vec![0.0, 12.0, 0.0]);
+    assert_eq!(numbers(&attr(&xml, "<emitter type=\"spot\"", "<lookat", "target")), vec![0.0, 11.0, 0.0]);
+    assert_eq!(numbers(&attr(&xml, "<emitter type=\"spot\"", "name=\"intensity\"", "value")), vec![32.0; 3]);
+    assert_eq!(numbers(&attr(&xml, "<emitter type=\"spot\"", "name=\"cutoff_angle\"", "value")), vec![30.0]);
+    assert_eq!(numbers(&attr(&xml, "<emitter type=\"spot\"", "name=\"beam_width\"", "value")), vec![25.0]);
+}
+
 #[test]
 fn a_mesh_far_from_unit_size_comes_out_in_the_same_millimetres() {
     // A 20000-unit slab at 0.01 mm per unit is 200 mm across; the renderer re-expresses it in

@@ -401,3 +401,33 @@ fn sampling_refuses_buffers_smaller_than_its_counts_need() {
     drop(ctx);
     assert_clean(&counts);
 }
+
+/// A narrow spot above a sphere lights only the cap inside its cone: there each point's
+/// irradiance is I cos θi Ft / d² (the falloff is 1 well inside), beyond the cone nothing.
+#[test]
+fn a_spot_lights_only_the_points_inside_its_cone() {
+    let (position, cone, delta) = (Vec3::new(0.0, 3.0, 0.5), 12.0f32, 2.0f32);
+    // Aimed off the centre, so that the cap is on one side.
+    let target = Vec3::new(0.3, 0.0, 0.0);
+    let spot = Light::spot(position, target, cone, delta, Vec3::splat(9.0)).unwrap();
+    let s = build(&Mesh::sphere(1.0, 48), &[spot], 16_384);
+    let axis = (target - position).normalize();
+    let (mut inside, mut outside) = (0, 0);
+    for p in &s.points {
+        let d = p.position - position;
+        let angle = d.normalize().dot(axis).clamp(-1.0, 1.0).acos().to_degrees();
+        let cos_i = p.normal.dot(-d.normalize());
+        if angle > cone + 0.2 {
+            assert_eq!(p.irradiance, Vec3::ZERO, "outside the cone ({angle}°): {p:?}");
+            outside += 1;
+        } else if angle < cone - delta - 0.2 && cos_i > 0.1 {
+            let expected = 9.0 * cos_i * ft(cos_i) / d.length_squared();
+            assert!(
+                (p.irradiance.x - expected).abs() < 1e-3 * expected,
+                "inside ({angle}°): {p:?} expected {expected}"
+            );
+            inside += 1;
+        }
+    }
+    assert!(inside > 200 && outside > 10_000, "{inside} points lit inside the cone, {outside} outside");
+}

@@ -225,3 +225,41 @@ fn shared_constants_are_the_rust_ones() {
     assert_eq!(value("MAX_LIGHTS"), Some(gpu::MAX_LIGHTS as u32));
     assert_eq!(value("RADIX_TILE"), Some(gpu::RADIX_TILE));
 }
+
+#[test]
+fn lights_match_glsl() {
+    use translucent::gpu::{GpuLight, LightSetHeader};
+    // Every shader that reads the lights (through light_at).
+    for shader in ["hierarchy/irradiance.comp", "shade.frag", "diffuse.frag"] {
+        let light = member_offsets(shader, "GpuLight").expect("GpuLight");
+        let rust: Vec<u32> = [
+            offset_of!(GpuLight, position),
+            offset_of!(GpuLight, intensity),
+            offset_of!(GpuLight, axis),
+            offset_of!(GpuLight, first_layer),
+            offset_of!(GpuLight, cube),
+            offset_of!(GpuLight, cos_falloff_start),
+            offset_of!(GpuLight, spot),
+        ]
+        .iter()
+        .map(|&o| o as u32)
+        .collect();
+        assert_eq!(light, rust, "{shader}");
+        let set = member_offsets(shader, "LightSet").expect("LightSet");
+        let rust: Vec<u32> = [
+            offset_of!(LightSetHeader, light_count),
+            offset_of!(LightSetHeader, eta),
+            offset_of!(LightSetHeader, normal_offset),
+            offset_of!(LightSetHeader, pad),
+            offset_of!(LightSetHeader, lights),
+        ]
+        .iter()
+        .map(|&o| o as u32)
+        .collect();
+        assert_eq!(set, rust, "{shader}");
+    }
+    assert_eq!(size_of::<GpuLight>(), 64);
+    // The layer matrices follow the header: a multiple of 16 bytes (std430's mat4 alignment).
+    assert_eq!(size_of::<LightSetHeader>(), 16 + 64 * translucent::gpu::MAX_LIGHTS);
+    assert_eq!(size_of::<LightSetHeader>() % 16, 0);
+}

@@ -266,11 +266,52 @@ fn scenes_render_with_pbrts_handedness_and_flags_override() {
     let err = common::stderr(&out);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains("infinite.pbrt:12:1: ") && err.contains("not rendered yet"), "{err}");
-    let spot = write(&d, "spot.pbrt", &(scene("", 0.0) + "LightSource \"spot\"\n"));
-    let err = common::stderr(&render(&[spot.to_str().unwrap()]));
-    assert!(err.contains("spot.pbrt:12:1: ") && err.contains("spot lights are not rendered yet"), "{err}");
     let bad = write(&d, "bad.pbrt", "WorldBegin\nShape \"cone\"\n");
     let out = render(&[bad.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2));
     assert!(common::stderr(&out).starts_with(&format!("error: {}:2:1: Shape \"cone\"", bad.display())));
+}
+
+/// `LightSource "spot"` renders: aimed at the sphere's right half (pbrt's +x, on the image's
+/// right), that half is the lit one, on the left once `Scale -1 1 1` mirrors the world (the spot's
+/// axis mirrored with the left-handed camera); a cone or falloff out of range, or `from` = `to`,
+/// is refused naming the file, line and column.
+#[test]
+fn spot_lights_render_aimed_and_bad_ones_name_the_line() {
+    let d = dir("spot");
+    let scene = |pre: &str, light: &str| {
+        format!(
+            "{pre}LookAt 0 0 -6  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 30\nFilm \"rgb\" \"integer xresolution\" 48 \"integer yresolution\" 32 \"string filename\" \"{}\"\n\
+             WorldBegin\n{light}\n\
+             Material \"subsurface\" \"string name\" \"Skin1\" \"float scale\" 10\nShape \"sphere\" \"float radius\" 0.6\n",
+            d.join("spot.png").display()
+        )
+    };
+    let aimed = "LightSource \"spot\" \"point3 from\" [0 0 -6] \"point3 to\" [0.4 0 0] \"float coneangle\" 3 \"float conedeltaangle\" 0.5 \"rgb I\" [400 400 400]";
+    for (pre, right) in [("", true), ("Scale -1 1 1\n", false)] {
+        let path = write(&d, "spot.pbrt", &scene(pre, aimed));
+        let out = render(&[path.to_str().unwrap(), "--samples", "4096"]);
+        let err = common::stderr(&out);
+        assert_eq!(out.status.code(), Some(0), "{err}");
+        assert!(!err.contains("is not used"), "every spot parameter read: {err}");
+        let (l, r) = halves(&d.join("spot.png"));
+        assert!(if right { r > 3.0 * l } else { l > 3.0 * r }, "pre {pre:?}: left {l} right {r}");
+    }
+    for (light, needle) in [
+        ("LightSource \"spot\" \"float coneangle\" 200", "LightSource \"spot\": cone angle 200°: must be in (0, 180]"),
+        ("LightSource \"spot\" \"float coneangle\" 0", "cone angle 0°"),
+        (
+            "LightSource \"spot\" \"float coneangle\" 10 \"float conedeltaangle\" 12",
+            "falloff width 12°: must be in [0, 10]",
+        ),
+        ("LightSource \"spot\" \"float conedeltaangle\" -1", "falloff width -1°"),
+        ("LightSource \"spot\" \"point3 from\" [0 2 0] \"point3 to\" [0 2 0]", "are the same point"),
+    ] {
+        let path = write(&d, "bad-spot.pbrt", &scene("", light));
+        let out = render(&[path.to_str().unwrap()]);
+        let err = common::stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{light}: {err}");
+        assert!(err.starts_with(&format!("error: {}:5:1: ", path.display())), "{light}: {err}");
+        assert!(err.contains(needle), "{light}: {err}");
+    }
 }

@@ -325,3 +325,120 @@ fn work_is_counted_per_object() {
     assert_eq!(all.point_sum, per_object[0].point_sum + per_object[1].point_sum);
     assert!(per_object.iter().all(|w| w.evaluation_sum > 0));
 }
+
+/// pbrt-v4's spot falloff (SpotLight::I with its SmoothStep) at cos θ off the axis, in f64.
+fn spot_falloff(cos_theta: f64, cone_deg: f64, delta_deg: f64) -> f64 {
+    let (a, b) = (cone_deg.to_radians().cos(), (cone_deg - delta_deg).to_radians().cos());
+    if a == b {
+        return if cos_theta < a { 0.0 } else { 1.0 };
+    }
+    let t = ((cos_theta - a) / (b - a)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}
+
+/// A spot aimed straight down at a large grey floor, seen from straight above: the floor shows
+/// ρ E / π with E = I f(θ) cos θ / d² (f: pbrt's smoothstep falloff), full inside the radius
+/// h tan(cone − delta), nothing beyond h tan(cone); the lit disc ends, and the full disc ends,
+/// within a pixel of those radii. Once with a 30° cone (one perspective shadow layer) and once
+/// with a 75° cone (the six cube faces).
+#[test]
+fn a_spot_lights_a_disc_of_the_floor_ending_where_its_cone_meets_it() {
+    use translucent::world::{Opaque, Reflectance};
+    let (size, px) = (96u32, 96.0f64);
+    // Seen from 12 above with tan(fov/2) = 5/12: the image spans the floor's −5..5.
+    let (eye_height, half_span) = (12.0f64, 5.0f64);
+    let fov = 2.0 * (half_span / eye_height).atan().to_degrees();
+    let camera = Camera {
+        eye: Vec3::new(0.0, eye_height as f32, 0.0),
+        target: Vec3::ZERO,
+        up: Vec3::NEG_Z,
+        fov_y_deg: fov as f32,
+    };
+    let pixel = 2.0 * half_span / px; // floor units per pixel
+    let rho = 0.5f32;
+    let (mesh, _) = floor(20.0, 0.0);
+    let floor = Opaque::new(mesh, Reflectance::Constant(Vec3::splat(rho)));
+    // A translucent object the world needs, out of view and out of the cone.
+    let aside = placed(Mesh::sphere(0.3, 16), "marble", Vec3::new(9.0, 0.3, 9.0), 1024);
+    for (cone, delta, h, intensity) in [(30.0f64, 10.0f64, 6.0f64, 40.0f64), (75.0, 15.0, 1.0, 2.0)] {
+        let spot = Light::spot(
+            Vec3::new(0.0, h as f32, 0.0),
+            Vec3::ZERO,
+            cone as f32,
+            delta as f32,
+            Vec3::splat(intensity as f32),
+        )
+        .unwrap();
+        let mut desc = FrameDesc::new(camera, vec![spot]);
+        (desc.width, desc.height, desc.shadow_resolution, desc.specular) = (size, size, 1024, false);
+        let world = World { objects: vec![aside.clone()], opaque: vec![floor.clone()], mm_per_unit: 10.0 };
+        let image = render(&world, &desc);
+        let path = common::output_dir().join(format!("spot-{cone}-on-floor.png"));
+        translucent::output::write_image(&path, &image, translucent::output::Exposure::Stops(0.0)).unwrap();
+        let (r_edge, r_full) = (h * cone.to_radians().tan(), h * (cone - delta).to_radians().tan());
+        let peak = rho as f64 * intensity / (std::f64::consts::PI * h * h);
+        let (mut max_lit, mut max_full, mut full_pixels) = (0.0f64, 0.0f64, 0);
+        for (i, p) in image.pixels.iter().enumerate() {
+            assert!(p[3] > 0.0, "pixel {i}: the floor fills the view");
+            let (x, y) = ((i as u32 % size) as f64, (i as u32 / size) as f64);
+            let ndc = ((x + 0.5) / px * 2.0 - 1.0, (y + 0.5) / px * 2.0 - 1.0);
+            let r = half_span * (ndc.0 * ndc.0 + ndc.1 * ndc.1).sqrt();
+            let d = (h * h + r * r).sqrt();
+            let cos = h / d;
+            let full = rho as f64 * intensity * cos / (d * d) / std::f64::consts::PI;
+            let want = full * spot_falloff(cos, cone, delta);
+            let v = p[0] as f64;
+            assert!((v - want).abs() <= 2e-3 * peak, "cone {cone}: pixel {i} at r {r:.3}: {v} vs {want}");
+            if r > r_edge + 0.5 * pixel {
+                assert_eq!(v, 0.0, "cone {cone}: pixel {i} at r {r:.3} beyond the cone's edge {r_edge:.3}");
+            }
+            if r < r_full - 0.5 * pixel {
+                assert!((v - full).abs() <= 1e-5 * full, "cone {cone}: pixel {i} at r {r:.3} inside: {v} vs {full}");
+                full_pixels += 1;
+            }
+            if v > 0.0 {
+                max_lit = max_lit.max(r);
+            }
+            if (v - full).abs() <= 1e-5 * full {
+                max_full = max_full.max(r);
+            }
+        }
+        assert!(full_pixels > 500, "cone {cone}: {full_pixels} fully lit pixels");
+        assert!(
+            (max_lit - r_edge).abs() < pixel,
+            "cone {cone}: the lit disc ends at {max_lit:.3}, the cone meets the floor at {r_edge:.3} (pixel {pixel:.3})"
+        );
+        assert!(
+            (max_full - r_full).abs() < 2.0 * pixel,
+            "cone {cone}: the full disc ends at {max_full:.3}, the falloff begins at {r_full:.3} (pixel {pixel:.3})"
+        );
+    }
+}
+
+/// A spot with a 180° cone and no falloff is a point light: the same image, bit for bit, of a
+/// translucent sphere (irradiance, specular) on an opaque floor (diffuse, shadows).
+#[test]
+fn a_180_degree_spot_is_a_point_light() {
+    use translucent::world::{Opaque, Reflectance};
+    let sphere = placed(Mesh::sphere(0.8, 24), "marble", Vec3::new(0.0, 0.8, 0.0), 4096);
+    let (mesh, _) = floor(6.0, 0.0);
+    let floor = Opaque::new(mesh, Reflectance::Constant(Vec3::new(0.6, 0.5, 0.4)));
+    let world = World { objects: vec![sphere], opaque: vec![floor], mm_per_unit: 10.0 };
+    let camera =
+        Camera { eye: Vec3::new(0.0, 3.0, 5.0), target: Vec3::new(0.0, 0.3, 0.0), up: Vec3::Y, fov_y_deg: 45.0 };
+    let (position, intensity) = (Vec3::new(1.5, 3.0, 1.0), Vec3::new(8.0, 7.0, 6.0));
+    let images = [
+        Light::Point { position, intensity },
+        Light::spot(position, Vec3::new(1.0, -2.0, 0.3), 180.0, 0.0, intensity).unwrap(),
+    ]
+    .map(|light| {
+        let mut desc = FrameDesc::new(camera, vec![light]);
+        (desc.width, desc.height) = (80, 60);
+        render(&world, &desc)
+    });
+    let lit = images[0].pixels.iter().filter(|p| p[0] > 0.0).count();
+    assert!(lit > 2000, "{lit} lit pixels");
+    for (i, (p, q)) in images[0].pixels.iter().zip(&images[1].pixels).enumerate() {
+        assert!(p.map(f32::to_bits) == q.map(f32::to_bits), "pixel {i}: point {p:?}, 180° spot {q:?}");
+    }
+}

@@ -3,12 +3,14 @@
 #define LIGHTS_GLSL
 #include "gpu_constants.glsl"
 struct GpuLight {
-    vec4 position;   // xyz: direction toward the light (w = 0) or its position (w = 1)
-    vec4 intensity;  // rgb: irradiance at normal incidence (directional) or radiant intensity (point)
-    uint first_layer; // its first shadow-map layer (point lights use 6: +x -x +y -y +z -z)
-    uint pad0;
-    uint pad1;
-    uint pad2;
+    vec4 position;   // xyz: direction toward the light (w = 0) or its position (w = 1: point, spot)
+    vec4 intensity;  // rgb: irradiance at normal incidence (directional) or radiant intensity (point,
+                     // spot: along its axis)
+    vec4 axis;       // spot lights: xyz the cone's axis from the light (unit), w cos(cone angle)
+    uint first_layer; // its first shadow-map layer
+    uint cube;       // 1: six layers, the cube faces +x -x +y -y +z -z (point lights, wide spots)
+    float cos_falloff_start; // spot lights: cos(cone angle - delta), where the falloff begins
+    uint spot;       // 1: a spot light (its falloff applies)
 };
 struct LightSet {
     uint light_count;
@@ -26,6 +28,17 @@ uint cube_face(vec3 d) {
     return d.z >= 0.0 ? 4u : 5u;
 }
 
+// A spot light's falloff at cos θ off its axis: pbrt-v4's SpotLight::I (src/pbrt/lights.cpp),
+// smoothstep from cos(cone angle) up to cos(cone angle - delta), with pbrt's SmoothStep
+// (src/pbrt/util/math.h): a step when the two are equal (delta 0). GLSL's own smoothstep is
+// undefined there.
+float spot_falloff(float cos_theta, float cos_total, float cos_start) {
+    float c = clamp(cos_theta, -1.0, 1.0);
+    if (cos_total == cos_start) return c < cos_total ? 0.0 : 1.0;
+    float t = clamp((c - cos_total) / (cos_start - cos_total), 0.0, 1.0);
+    return t * t * (3.0 - 2.0 * t);
+}
+
 // What `light` sends to the point x: the unit direction toward it, the irradiance on a surface
 // facing it (returned), and the shadow-map layer that sees x.
 vec3 light_at(GpuLight light, vec3 x, out vec3 toward, out uint layer) {
@@ -37,7 +50,9 @@ vec3 light_at(GpuLight light, vec3 x, out vec3 toward, out uint layer) {
     vec3 d = light.position.xyz - x;
     float d2 = max(dot(d, d), 1e-20);
     toward = d * inversesqrt(d2);
-    layer += cube_face(-d);
-    return light.intensity.rgb / d2;
+    if (light.cube != 0u) layer += cube_face(-d);
+    vec3 e = light.intensity.rgb / d2;
+    if (light.spot != 0u) e *= spot_falloff(dot(-toward, light.axis.xyz), light.axis.w, light.cos_falloff_start);
+    return e;
 }
 #endif

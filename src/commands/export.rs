@@ -103,7 +103,7 @@ pub(super) fn mitsuba(args: &MitsubaArgs) -> Result<i32> {
     Ok(0)
 }
 
-/// A light of the scene in mm: positions × mm per unit, point intensities × (mm per unit)² (the
+/// A light of the scene in mm: positions × mm per unit, point and spot intensities × (mm per unit)² (the
 /// renderer's E = I / d² takes d in scene units).
 pub fn light_in_mm(light: &scene::Light, mm: f64) -> Light {
     let v = |v: glam::Vec3| [v.x as f64, v.y as f64, v.z as f64];
@@ -114,5 +114,12 @@ pub fn light_in_mm(light: &scene::Light, mm: f64) -> Light {
         scene::Light::Point { position, intensity } => {
             Light::Point { position: position.as_dvec3() * mm, intensity: v(intensity).map(|i| i * mm * mm) }
         }
+        scene::Light::Spot { position, axis, intensity, cone_deg, delta_deg } => Light::Spot {
+            position: position.as_dvec3() * mm,
+            axis: axis.as_dvec3(),
+            intensity: v(intensity).map(|i| i * mm * mm),
+            cone_deg: cone_deg as f64,
+            delta_deg: delta_deg as f64,
+        },
     }
 }

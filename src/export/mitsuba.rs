@@ -54,6 +54,9 @@ pub enum Light {
     Directional { toward: DVec3, irradiance: [f64; 3] },
     /// Radiant intensity per channel such that E = intensity / d², d in mm.
     Point { position: DVec3, intensity: [f64; 3] },
+    /// A point light into a cone of half-angle `cone_deg` about `axis` (unit, from the light),
+    /// falling off over its outer `delta_deg` (pbrt-v4's `spot`, see [`crate::scene::Light::Spot`]).
+    Spot { position: DVec3, axis: DVec3, intensity: [f64; 3], cone_deg: f64, delta_deg: f64 },
 }
 
 /// A homogeneous medium, coefficients per mm.
@@ -375,6 +378,38 @@ pub fn write_scene(
                 );
                 let _ = writeln!(w, "        <rgb name=\"intensity\" value=\"{}\"/>", triple(intensity));
                 let _ = writeln!(w, "    </emitter>");
+            }
+            Light::Spot { position, axis, intensity, cone_deg, delta_deg } => {
+                // Mitsuba 3's `spot` (src/emitters/spot.cpp) ramps linearly in the angle from
+                // beam_width out to cutoff_angle; pbrt-v4's and translucent's is a smoothstep in
+                // cos θ over the same rim: equal inside the beam and beyond the cone, not between.
+                let _ = writeln!(
+                    w,
+                    "    <!-- light {i}: spot, cone {}°, falloff over its outer {}° (Mitsuba's ramp is linear in the angle there, translucent's a smoothstep in cos θ) -->",
+                    num(cone_deg),
+                    num(delta_deg)
+                );
+                let _ = writeln!(w, "    <emitter type=\"spot\" id=\"light{i}\">");
+                let _ = writeln!(w, "        <transform name=\"to_world\">");
+                let _ = writeln!(
+                    w,
+                    "            <lookat origin=\"{}\" target=\"{}\" up=\"{}\"/>",
+                    triple(dv(position)),
+                    triple(dv(position + axis)),
+                    triple(dv(any_up(axis)))
+                );
+                let _ = writeln!(w, "        </transform>");
+                let _ = writeln!(w, "        <rgb name=\"intensity\" value=\"{}\"/>", triple(intensity));
+                let _ = writeln!(w, "        <float name=\"cutoff_angle\" value=\"{}\"/>", num(cone_deg));
+                let _ = writeln!(w, "        <float name=\"beam_width\" value=\"{}\"/>", num(cone_deg - delta_deg));
+                let _ = writeln!(w, "    </emitter>");
+                if delta_deg > 0.0 {
+                    written.warnings.push(format!(
+                        "light {i}: spot: Mitsuba's falloff over the outer {}° of its {}° cone is linear in the angle, translucent's (pbrt-v4's) a smoothstep in cos θ: the images differ on that rim",
+                        num(delta_deg),
+                        num(cone_deg)
+                    ));
+                }
             }
         }
     }

@@ -11,8 +11,15 @@ use super::MAX_LIGHTS;
 pub struct GpuLight {
     pub position: Vec4,
     pub intensity: Vec4,
+    /// Spot lights: the cone's axis from the light (xyz), cos of the cone angle (w).
+    pub axis: Vec4,
     pub first_layer: u32,
-    pub pad: [u32; 3],
+    /// 1: six cube-face layers (point lights, spots wider than 60°); 0: one layer.
+    pub cube: u32,
+    /// Spot lights: cos(cone angle − delta), where the falloff begins.
+    pub cos_falloff_start: f32,
+    /// 1: a spot light.
+    pub spot: u32,
 }
 
 /// Mirrors `LightSet` in shaders/include/lights.glsl; the layer matrices follow it in the buffer.

@@ -1,5 +1,6 @@
 //! Shadow maps: the depth of every object seen from each light, one layer of a 2D-array depth
-//! image per directional light and six (+x −x +y −y +z −z) per point light, fitted to the object
+//! image per directional light, six (+x −x +y −y +z −z) per point light, one perspective layer
+//! per spot light (six, as a point light, when its cone is wider than 60°), fitted to the object
 //! that receives the shadows. Reads: every object's vertices and indices. Writes: the shadow map.
 
 use glam::{Mat4, Vec3};
@@ -43,33 +44,63 @@ pub fn light_matrices(light: &Light, centre: Vec3, radius: f32, casters: Option<
             let (near, far) = (0.5 * radius, 3.5 * radius + extra);
             vec![Mat4::orthographic_rh(-radius, radius, -radius, radius, near, far) * view]
         }
-        Light::Point { position, .. } => {
-            let distance = (position - centre).length();
-            let far = distance + radius * 1.01;
-            let mut near = distance - radius * 1.01;
-            if let Some((lo, hi)) = casters {
-                // The casters' nearest point to the light.
-                near = near.min((position.clamp(lo, hi) - position).length());
-            }
-            let near = near.max(far * 1e-4);
-            let faces = [
-                (Vec3::X, Vec3::Y),
-                (Vec3::NEG_X, Vec3::Y),
-                (Vec3::Y, Vec3::Z),
-                (Vec3::NEG_Y, Vec3::Z),
-                (Vec3::Z, Vec3::Y),
-                (Vec3::NEG_Z, Vec3::Y),
-            ];
-            faces
-                .iter()
-                .map(|&(dir, up)| {
-                    // A slightly wider cone than 90° so the face edges overlap.
-                    Mat4::perspective_rh(91f32.to_radians(), 1.0, near, far)
-                        * Mat4::look_at_rh(position, position + dir, up)
-                })
-                .collect()
+        Light::Point { position, .. } => cube_faces(position, centre, radius, casters),
+        Light::Spot { .. } if light.shadow_layers() == 6 => {
+            cube_faces(light.position().unwrap(), centre, radius, casters)
+        }
+        Light::Spot { position, axis, cone_deg, .. } => {
+            let (near, far) = near_far(position, centre, radius, casters);
+            // The narrower of two cones that hold every point of the receiver the spot lights (and
+            // so every caster between them): the spot's own, and, from outside the receiver's
+            // sphere, the one around the direction to its centre that holds the sphere.
+            let to_centre = centre - position;
+            let distance = to_centre.length();
+            let cone = cone_deg.to_radians();
+            let (dir, half) = match (radius / distance).asin() {
+                holds if distance > radius && holds < cone => (to_centre / distance, holds),
+                _ => (axis, cone),
+            };
+            let up = if dir.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
+            // A little wider, as the cube faces are, so the cone's edge stays inside the map.
+            vec![
+                Mat4::perspective_rh(2.0 * half * 1.01 + 1f32.to_radians(), 1.0, near, far)
+                    * Mat4::look_at_rh(position, position + dir, up),
+            ]
         }
     }
+}
+
+/// The depth range of a light at `position` for a receiver in the sphere (centre, radius): the
+/// sphere's, reaching toward the light as far as the casters' nearest point to it.
+fn near_far(position: Vec3, centre: Vec3, radius: f32, casters: Option<(Vec3, Vec3)>) -> (f32, f32) {
+    let distance = (position - centre).length();
+    let far = distance + radius * 1.01;
+    let mut near = distance - radius * 1.01;
+    if let Some((lo, hi)) = casters {
+        // The casters' nearest point to the light.
+        near = near.min((position.clamp(lo, hi) - position).length());
+    }
+    (near.max(far * 1e-4), far)
+}
+
+/// The six 91° cube faces of a light at `position` (+x −x +y −y +z −z).
+fn cube_faces(position: Vec3, centre: Vec3, radius: f32, casters: Option<(Vec3, Vec3)>) -> Vec<Mat4> {
+    let (near, far) = near_far(position, centre, radius, casters);
+    let faces = [
+        (Vec3::X, Vec3::Y),
+        (Vec3::NEG_X, Vec3::Y),
+        (Vec3::Y, Vec3::Z),
+        (Vec3::NEG_Y, Vec3::Z),
+        (Vec3::Z, Vec3::Y),
+        (Vec3::NEG_Z, Vec3::Y),
+    ];
+    faces
+        .iter()
+        .map(|&(dir, up)| {
+            // A slightly wider cone than 90° so the face edges overlap.
+            Mat4::perspective_rh(91f32.to_radians(), 1.0, near, far) * Mat4::look_at_rh(position, position + dir, up)
+        })
+        .collect()
 }
 
 pub struct ShadowPass {

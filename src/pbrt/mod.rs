@@ -307,7 +307,10 @@ pub fn render_settings(
             LightDesc::Point { from, i, scale, .. } => {
                 lights.push(Light::Point { position: from.as_vec3(), intensity: rgb(*i, *scale) })
             }
-            LightDesc::Spot { loc, .. } => return Err(not_yet(loc, "LightSource \"spot\": spot lights are")),
+            LightDesc::Spot { from, to, coneangle, conedelta, i, scale, loc } => lights.push(
+                Light::spot(from.as_vec3(), to.as_vec3(), *coneangle as f32, *conedelta as f32, rgb(*i, *scale))
+                    .map_err(|e| bad_input!("{loc}: LightSource \"spot\": {e}"))?,
+            ),
             LightDesc::Infinite { loc, .. } => {
                 return Err(not_yet(loc, "LightSource \"infinite\": environment lights are"))
             }
@@ -381,6 +384,10 @@ pub fn render_settings(
             match l {
                 Light::Directional { toward, .. } => *toward = mirror_v(toward.as_dvec3()).as_vec3(),
                 Light::Point { position, .. } => *position = mirror(position.as_dvec3()).as_vec3(),
+                Light::Spot { position, axis, .. } => {
+                    *position = mirror(position.as_dvec3()).as_vec3();
+                    *axis = mirror_v(axis.as_dvec3()).normalize().as_vec3();
+                }
             }
         }
     }

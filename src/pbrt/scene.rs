@@ -617,7 +617,8 @@ impl Parser {
                 from: point("from", [0.0; 3])?,
                 to: point("to", [0.0, 0.0, 1.0])?,
                 coneangle: p.float("coneangle", 30.0)?,
-                conedelta: p.float("conedelta", 5.0)?,
+                // pbrt-v4's name (SpotLight::Create, after RenderMan's spotlight shader).
+                conedelta: p.float("conedeltaangle", 5.0)?,
                 i: colour("I")?,
                 scale,
                 loc: loc.clone(),

@@ -167,7 +167,9 @@ pub fn parse_line(line: &str) -> std::result::Result<Action, String> {
         "light" => match args {
             ["turn", r, u] => Action::TurnLights { right_deg: number(r)?, up_deg: number(u)? },
             [spec] => Action::SetLight(crate::cli::light_spec(spec)?),
-            _ => return Err("expected `light dir:X,Y,Z[:I]`, `light point:X,Y,Z[:I]` or `light turn RIGHT_DEG UP_DEG`".into()),
+            _ => {
+                return Err(format!("expected `light SPEC` ({}) or `light turn RIGHT_DEG UP_DEG`", crate::cli::LIGHT_FORMS))
+            }
         },
         "material" => {
             want(1, "material NAME")?;
@@ -310,6 +312,14 @@ pub fn turn_lights(lights: &mut [Light], camera: &Camera, centre: Vec3, right_de
             Light::Point { position, intensity } => {
                 Light::Point { position: centre + turn * (position - centre), intensity }
             }
+            // The position turns about the centre and the axis with it, as if carried rigidly.
+            Light::Spot { position, axis, intensity, cone_deg, delta_deg } => Light::Spot {
+                position: centre + turn * (position - centre),
+                axis: (turn * axis).normalize(),
+                intensity,
+                cone_deg,
+                delta_deg,
+            },
         };
     }
 }
@@ -362,6 +372,18 @@ mod tests {
     }
 
     #[test]
+    fn spots_turn_position_and_axis_together() {
+        // A spot in front of the centre, aimed at it: dragged to the back, still aimed at it.
+        let spot = Light::spot(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, 20.0, 5.0, Vec3::ONE).unwrap();
+        let mut lights = [spot];
+        turn_lights(&mut lights, &camera(), Vec3::ZERO, 180.0, 0.0);
+        let Light::Spot { position, axis, cone_deg, delta_deg, .. } = lights[0] else { unreachable!() };
+        assert!((position - Vec3::new(0.0, 0.0, -3.0)).length() < 1e-5, "{position}");
+        assert!((axis - Vec3::Z).length() < 1e-5, "{axis}");
+        assert_eq!((cone_deg, delta_deg), (20.0, 5.0));
+    }
+
+    #[test]
     fn script_lines_parse_or_name_the_problem() {
         let script = "# a comment\norbit 30 0\n\nzoom 1.2\nlight dir:-0.3,0.7,-0.6\nmaterial skin1\nset epsilon 0.05\nframes 3\nscreenshot a.png\nresize 640 480\nquit\n";
         let lines = parse_script(script).unwrap();
@@ -369,6 +391,11 @@ mod tests {
         assert_eq!(lines[0].number, 2);
         assert_eq!(lines[0].action, Action::Orbit { right_deg: 30.0, up_deg: 0.0 });
         assert_eq!(lines[4].action, Action::Set(Setting::Epsilon(0.05)));
+        let spot = parse_script("light spot:0,2,0:0,0,0:30:5:2\n").unwrap();
+        assert_eq!(
+            spot[0].action,
+            Action::SetLight(Light::spot(Vec3::new(0.0, 2.0, 0.0), Vec3::ZERO, 30.0, 5.0, Vec3::splat(2.0)).unwrap())
+        );
         for (bad, needle) in [
             ("orbit 30", "expected"),
             ("zoom -1", "positive"),
@@ -378,6 +405,9 @@ mod tests {
             ("resize 0 10", "both 0"),
             ("screenshot a.jpg", ".png"),
             ("light dir:0,0", "X,Y,Z"),
+            ("light spot:0,1,0:0,0,0:200", "cone angle 200°"),
+            ("light spot:0,1,0", "spot:X,Y,Z:TX,TY,TZ:ANGLE"),
+            ("light", "light SPEC"),
         ] {
             let (n, _, why) = parse_script(&format!("quit\n{bad}\n")).unwrap_err();
             assert_eq!(n, 2, "{bad}");
