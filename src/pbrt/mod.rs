@@ -280,7 +280,7 @@ pub fn render_settings(
     }
     let shown = path.display();
     let not_yet = |loc: &Loc, what: &str| {
-        bad_input!("{loc}: {what} not rendered yet (today a scene renders shapes with subsurface and diffuse materials, lit by distant and point lights)")
+        bad_input!("{loc}: {what} not rendered yet (today a scene renders shapes with subsurface and diffuse materials, lit by distant, point and spot lights)")
     };
     let mut translucent = Vec::new();
     let mut opaque = Vec::new();
