@@ -192,7 +192,12 @@ impl Light {
     /// The light turned by `angle` radians about the axis `up` through `centre` (directions turn
     /// about `up`, positions about the axis through `centre`).
     pub fn rotated(&self, up: Vec3, angle: f32, centre: Vec3) -> Light {
-        let turn = glam::Quat::from_axis_angle(up.normalize_or(Vec3::Y), angle);
+        self.turned(glam::Quat::from_axis_angle(up.normalize_or(Vec3::Y), angle), centre)
+    }
+
+    /// The light turned by `turn` about `centre`, as if carried rigidly: directions and a spot's
+    /// axis turn, positions turn about `centre`.
+    pub fn turned(&self, turn: glam::Quat, centre: Vec3) -> Light {
         match *self {
             Light::Directional { toward, irradiance } => Light::Directional { toward: turn * toward, irradiance },
             Light::Point { position, intensity } => {

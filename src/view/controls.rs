@@ -307,20 +307,7 @@ pub fn turn_lights(lights: &mut [Light], camera: &Camera, centre: Vec3, right_de
     // Dragging right moves the light to the right as seen on screen: about the screen's up axis.
     let turn = Quat::from_axis_angle(right, -up_deg.to_radians()) * Quat::from_axis_angle(up, right_deg.to_radians());
     for light in lights {
-        *light = match *light {
-            Light::Directional { toward, irradiance } => Light::Directional { toward: turn * toward, irradiance },
-            Light::Point { position, intensity } => {
-                Light::Point { position: centre + turn * (position - centre), intensity }
-            }
-            // The position turns about the centre and the axis with it, as if carried rigidly.
-            Light::Spot { position, axis, intensity, cone_deg, delta_deg } => Light::Spot {
-                position: centre + turn * (position - centre),
-                axis: (turn * axis).normalize(),
-                intensity,
-                cone_deg,
-                delta_deg,
-            },
-        };
+        *light = light.turned(turn, centre);
     }
 }
 
