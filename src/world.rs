@@ -98,6 +98,9 @@ impl PartialEq for Texture {
 
 /// The largest texture side accepted (the device's image limit is checked when it is made).
 pub const MAX_TEXTURE_SIDE: u32 = 16384;
+/// The most texels a texture may have: 2^24 (4096², 256 MiB as RGBA32F on the host and the GPU),
+/// so that memory stays bounded whatever a file's header claims.
+pub const MAX_TEXTURE_TEXELS: u64 = 1 << 24;
 
 impl Texture {
     /// Reads a PNG (sRGB-encoded, decoded to linear) or an EXR (linear) file; `shown` names it in
@@ -111,9 +114,15 @@ impl Texture {
         let reader = image::ImageReader::open(path).map_err(|e| bad_input!("{shown}: {e}"))?;
         let reader = reader.with_guessed_format().map_err(|e| bad_input!("{shown}: {e}"))?;
         let (width, height) = reader.into_dimensions().map_err(|e| bad_input!("{shown}: not an image: {e}"))?;
-        if width == 0 || height == 0 || width > MAX_TEXTURE_SIDE || height > MAX_TEXTURE_SIDE {
+        let texels = width as u64 * height as u64;
+        if width == 0
+            || height == 0
+            || width > MAX_TEXTURE_SIDE
+            || height > MAX_TEXTURE_SIDE
+            || texels > MAX_TEXTURE_TEXELS
+        {
             return Err(bad_input!(
-                "{shown}: {width}x{height}: a texture's sides must be between 1 and {MAX_TEXTURE_SIDE}"
+                "{shown}: {width}x{height}: a texture's sides must be between 1 and {MAX_TEXTURE_SIDE}, and it may have at most {MAX_TEXTURE_TEXELS} texels"
             ));
         }
         let img = image::open(path).map_err(|e| bad_input!("{shown}: not an image: {e}"))?.into_rgba32f();

@@ -285,7 +285,24 @@ Shape "trianglemesh" "integer indices" [ 0 2 1 0 3 2 ] "point3 P" [ -4 0 -4 4 0 
     assert!(blue.2 < red.2 && grey.2 < green.2, "the image's bottom row at v = 0 (−z, far): {found:?}");
     // A missing image, and one that is not an image: exit 2 naming the scene's line and the file.
     std::fs::write(dir.join("garbage.png"), [0x89u8, b'P', b'N', b'G', 0, 1, 2, 3]).unwrap();
-    for (file, needle) in [("missing.png", "missing.png"), ("garbage.png", "not an image")] {
+    // A header that claims 100,000 × 100,000 texels, and no data: refused before anything is
+    // allocated for it.
+    let chunk = |kind: &[u8], data: &[u8]| {
+        let mut c = (data.len() as u32).to_be_bytes().to_vec();
+        c.extend_from_slice(kind);
+        c.extend_from_slice(data);
+        let crc = crc32(&c[4..]);
+        c.extend_from_slice(&crc.to_be_bytes());
+        c
+    };
+    let mut huge = b"\x89PNG\r\n\x1a\n".to_vec();
+    let mut header = 100_000u32.to_be_bytes().to_vec();
+    header.extend_from_slice(&100_000u32.to_be_bytes());
+    header.extend_from_slice(&[8, 2, 0, 0, 0]);
+    huge.extend(chunk(b"IHDR", &header));
+    huge.extend(chunk(b"IEND", &[]));
+    std::fs::write(dir.join("huge.png"), huge).unwrap();
+    for (file, needle) in [("missing.png", "missing.png"), ("garbage.png", "not an image"), ("huge.png", "huge.png")] {
         let bad = dir.join(format!("bad-{file}.pbrt"));
         std::fs::write(&bad, scene.replace("quadrants.png", file)).unwrap();
         let out = common::translucent(&["render", bad.to_str().unwrap(), "--out", exr.to_str().unwrap()]);
@@ -441,4 +458,16 @@ fn a_180_degree_spot_is_a_point_light() {
     for (i, (p, q)) in images[0].pixels.iter().zip(&images[1].pixels).enumerate() {
         assert!(p.map(f32::to_bits) == q.map(f32::to_bits), "pixel {i}: point {p:?}, 180° spot {q:?}");
     }
+}
+
+/// CRC-32 (PNG's) of `bytes`.
+fn crc32(bytes: &[u8]) -> u32 {
+    let mut crc = 0xffff_ffffu32;
+    for &b in bytes {
+        crc ^= b as u32;
+        for _ in 0..8 {
+            crc = if crc & 1 != 0 { (crc >> 1) ^ 0xedb8_8320 } else { crc >> 1 };
+        }
+    }
+    !crc
 }
