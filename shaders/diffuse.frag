@@ -2,6 +2,8 @@
 // Opaque objects: Lambertian reflection of every light, shadowed by every object, per pixel of
 // the G-buffer whose id is an opaque object's: Lo = ρ/π · Σ_k E_k · max(0, n·l_k) · V_k.
 #include "diffuse_constants.glsl"
+// The lights and the shadow maps fitted to the opaque objects.
+#define LIGHTS_BINDING 3
 #include "lights.glsl"
 
 layout(location = 0) out vec4 radiance;
@@ -9,8 +11,6 @@ layout(location = 0) out vec4 radiance;
 layout(binding = 0, rgba32f) uniform readonly image2D surface_position;
 layout(binding = 1, rgba32f) uniform readonly image2D surface_normal;
 layout(binding = 2, rgba32f) uniform readonly image2D surface_albedo;
-// The lights and the shadow maps fitted to the opaque objects.
-layout(std430, binding = 3) readonly buffer Lights { LightSet light_set; mat4 layer_matrices[]; };
 layout(binding = 4) uniform sampler2DArrayShadow shadow_map;
 
 const float PI = 3.14159265358979;
@@ -27,10 +27,10 @@ void main() {
     for (uint k = 0u; k < light_set.light_count; ++k) {
         vec3 toward;
         uint layer;
-        vec3 incident = light_at(light_set.lights[k], x, toward, layer);
+        vec3 incident = light_at(light_of(k), x, toward, layer);
         float cos_i = dot(n, toward);
         if (cos_i <= 0.0) continue;
-        vec4 clip = layer_matrices[layer] * vec4(x + n * light_set.normal_offset, 1.0);
+        vec4 clip = layer_matrix(layer) * vec4(x + n * light_set.normal_offset, 1.0);
         vec3 ndc = clip.xyz / clip.w;
         float visibility = texture(shadow_map, vec4(ndc.xy * 0.5 + 0.5, float(layer), ndc.z));
         sum += incident * cos_i * visibility;

@@ -1,18 +1,21 @@
 #version 460
 // Subsurface scattering per pixel, in a full-screen pass over the G-buffer of the surface pass.
 // The pixel's sources come from its tile's list (tile_cut.comp): nodes used whole for the whole
-// tile (two sigma points per light), points evaluated singly (one source per light), and frontier
+// tile (two sigma points), points evaluated singly, and frontier
 // nodes that this pixel walks on its own (a node far and small enough from xo, area / distance²
 // < epsilon and xo outside its box, is used whole, else its children are visited). A tile whose
-// list did not fit, and brute force, sum from the root or over every point instead.
-// Lo(xo, wo) = Ft(eta, wo) · Σ over sources and lights Sd(xi, wi_k; xo, no) · power_k, power = E·A
-// (mm²), plus the surface's own reflection from each light: a microfacet lobe, shadowed by the
-// same shadow maps. Which nodes are used whole does not depend on the lights, and each term
-// depends on one light only, so renders of several lights are the sums of each alone.
+// list did not fit sums from the root instead. Every source carries all the lights at once
+// (PointFlux, NodeFlux: per channel the power and the power-weighted refracted direction), so the
+// cost does not grow with the number of lights; brute force instead sums over every (point,
+// light) pair exactly, the reference the merged records are measured against.
+// Lo(xo, wo) = Ft(eta, wo) · Σ over sources Sd(xi, ω12; xo, no) · power, power = E·A (mm²), plus
+// the surface's own reflection from each light: a microfacet lobe, shadowed by the same shadow
+// maps. Which nodes are used whole does not depend on the lights.
 #include "common.glsl"
 #include "shade_constants.glsl"
 #include "points.glsl"
 #include "shading_params.glsl"
+#define LIGHTS_BINDING 4
 #include "lights.glsl"
 #include "microfacet.glsl"
 #include "tile_lists.glsl"
@@ -34,11 +37,10 @@ layout(binding = 2) uniform usamplerBuffer points;
 // One record per translucent object, indexed by the object shaded.
 struct WorkCounters { uint pixels; uint node_sum; uint node_max; uint point_sum; uint point_max; uint evaluation_sum; };
 layout(std430, binding = 3) buffer Work { WorkCounters objects[]; } work;
-layout(std430, binding = 4) readonly buffer Lights { LightSet light_set; mat4 layer_matrices[]; };
 layout(binding = 5) uniform sampler2DArrayShadow shadow_map;
-// Per-light records as texels: PointLight (sorted), NodeLight.
+// Light records as texels: PointLight (sorted, brute force only), NodeFlux.
 layout(binding = 6) uniform usamplerBuffer point_lights;
-layout(binding = 7) uniform usamplerBuffer node_lights;
+layout(binding = 7) uniform usamplerBuffer node_flux;
 // The surface pass's G-buffer: world position (w = 1 where covered) and interpolated normal.
 layout(binding = 8, rgba32f) uniform readonly image2D surface_position;
 layout(binding = 9, rgba32f) uniform readonly image2D surface_normal;
@@ -48,11 +50,13 @@ layout(binding = 11) uniform usamplerBuffer tile_entries;
 // The classical dipole's Sd per channel, tabulated (bssrdf.glsl).
 layout(binding = 12) uniform usamplerBuffer dipole_table;
 layout(std140, binding = 13) uniform Frame { FrameParams frame_params; };
+// PointFlux (sorted) as texels.
+layout(binding = 14) uniform usamplerBuffer point_flux;
 vec4 dipole_header; // its texel 0, read once per pixel
 
 const uint STACK_SIZE = 96u;
 // Stack entries: a point or node index (below 2^24, with LEAF_BIT for points) and the number of
-// its next evaluation plus one (2 · MAX_LIGHTS at most).
+// its next evaluation plus one (a node's second sigma point).
 const uint EVALUATION_SHIFT = 24u;
 const uint EVALUATION_MASK = 0x1fu;
 // Steps of the walk (tests of nodes and points, and evaluations) before it stops opening nodes:
@@ -76,7 +80,33 @@ vec3 source(vec3 xi, vec3 ni, vec3 wi, vec3 power, vec3 xo, vec3 no) {
     return sd * power * (s * s); // power is irradiance × scene-unit area: to mm²
 }
 
-// One light's record of one point: record = point · light_count + light.
+// Every light's flux from xi at once: `power` (irradiance × scene-unit area) per channel, and
+// `incident` (PointFlux's sums times the area): the power-weighted sum of the refracted
+// directions, at the source's normal ni, is -(Σωi - (Σωi·ni)ni)/η - ni Σcos θt.
+vec3 merged_source(vec3 xi, vec3 ni, vec3 power, vec4 incident[3], vec3 xo, vec3 no) {
+    float s = object_params.mm_per_unit;
+    vec3 sd;
+    if (MODEL == MODEL_DIRECTIONAL) {
+        // The geometry once; per channel only its mean refracted direction (equal for lights of
+        // one colour, different under an environment).
+        vec3 xi_mm = xi * s, xo_mm = xo * s;
+        float inv_eta = 1.0 / object_params.channels[0].eta;
+        vec3 w[3];
+        for (uint c = 0u; c < 3u; ++c) {
+            vec3 t = incident[c].xyz - dot(incident[c].xyz, ni) * ni;
+            w[c] = power[c] > 0.0 ? (-t * inv_eta - ni * incident[c].w) / power[c] : vec3(0.0);
+        }
+        DirpoleGeometry g = dirpole_geometry_refracted(xi_mm, ni, w[0], xo_mm, no);
+        sd.x = dirpole_channel_sd(object_params.channels[0], g, xi_mm, xo_mm, no);
+        sd.y = dirpole_channel_sd(object_params.channels[1], with_refracted(g, w[1], no), xi_mm, xo_mm, no);
+        sd.z = dirpole_channel_sd(object_params.channels[2], with_refracted(g, w[2], no), xi_mm, xo_mm, no);
+    } else {
+        sd = dipole_sd_table(dipole_table, dipole_header, length(xo - xi) * s);
+    }
+    return sd * power * (s * s); // power is irradiance × scene-unit area: to mm²
+}
+
+// One light's record of one point (brute force): record = point · light_count + light.
 vec3 point_light_source(uint record, uint light_count, vec3 xo, vec3 no) {
     uvec4 l = texel(point_lights, record);
     vec3 irradiance = uintBitsToFloat(l.xyz);
@@ -87,32 +117,29 @@ vec3 point_light_source(uint record, uint light_count, vec3 xo, vec3 no) {
     return source(position_area.xyz, normal, decode_oct(l.w), irradiance * position_area.w, xo, no);
 }
 
-// The parameters of one source: point `index` for light k.
-void point_source(uint index, uint k, uint light_count, out vec3 xi, out vec3 power, out uint toward_oct) {
-    uvec4 l = texel(point_lights, index * light_count + k);
+// Point `index` as a merged source: its position, power and flux (times its area).
+void point_source(uint index, out vec3 xi, out vec3 power, out vec4 incident[3]) {
     vec4 position_area = texel_float(points, index * POINT_TEXELS);
     xi = position_area.xyz;
-    power = uintBitsToFloat(l.xyz) * position_area.w;
-    toward_oct = l.w;
+    power = texel_float(points, index * POINT_TEXELS + 2u).xyz * position_area.w;
+    for (uint c = 0u; c < 3u; ++c) incident[c] = texel_float(point_flux, index * POINT_FLUX_TEXELS + c) * position_area.w;
 }
 
-// The two sources of node `index` used whole for light k: sigma points center ± offset, each
-// with half the power. A node used whole is not one source at its power centre c: Sd is convex in distance, so that
+// The two sources of node `index` used whole: sigma points center ± offset, each with half the
+// power. A node used whole is not one source at its power centre c: Sd is convex in distance, so that
 // underestimates it (1-1.5% on a slab). Two sigma points c ± s(u + t), s² = spread²/2 per axis of
 // the node's tangent plane (u toward xo, t across), match the points' mean and second moments, so
 // Sd's curvature along u and t is taken into account to second order.
-void node_sigma(uint index, uint k, uint light_count, vec3 ni, vec3 xo, out vec3 center, out vec3 offset,
-                out vec3 power, out uint toward_oct) {
-    uint record = (index * light_count + k) * NODE_LIGHT_TEXELS;
-    uvec4 power_toward = texel(node_lights, record);
-    vec4 center_spread = texel_float(node_lights, record + 1u);
+void node_sigma(uint index, vec3 ni, vec3 xo, out vec3 center, out vec3 offset, out vec3 power, out vec4 incident[3]) {
+    uint record = index * NODE_FLUX_TEXELS;
+    power = 0.5 * texel_float(nodes, index * NODE_TEXELS).xyz;
+    for (uint c = 0u; c < 3u; ++c) incident[c] = 0.5 * texel_float(node_flux, record + c);
+    vec4 center_spread = texel_float(node_flux, record + 3u);
     center = center_spread.xyz;
     vec3 towards_xo = xo - center;
     vec3 u = towards_xo - ni * dot(towards_xo, ni);
     u = dot(u, u) > 0.0 ? normalize(u) : normalize(cross(ni, abs(ni.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0)));
     offset = sqrt(0.5 * center_spread.w) * (u + cross(ni, u));
-    power = 0.5 * uintBitsToFloat(power_toward.xyz);
-    toward_oct = power_toward.w;
 }
 
 uint tile_entry(uint i) { return texel(tile_entries, i >> 2)[i & 3u]; }
@@ -123,10 +150,10 @@ vec3 specular(vec3 xo, vec3 no, vec3 wo) {
     for (uint k = 0u; k < light_set.light_count; ++k) {
         vec3 toward;
         uint layer;
-        vec3 incident = light_at(light_set.lights[k], xo, toward, layer);
+        vec3 incident = light_at(light_of(k), xo, toward, layer);
         float f_cos = microfacet_reflect_cos(no, toward, wo, frame_params.roughness, object_params.channels[0].eta);
         if (f_cos <= 0.0) continue;
-        vec4 clip = layer_matrices[layer] * vec4(xo + no * light_set.normal_offset, 1.0);
+        vec4 clip = layer_matrix(layer) * vec4(xo + no * light_set.normal_offset, 1.0);
         vec3 ndc = clip.xyz / clip.w;
         float visibility = texture(shadow_map, vec4(ndc.xy * 0.5 + 0.5, float(layer), ndc.z));
         sum += f_cos * incident * visibility;
@@ -168,29 +195,29 @@ void main() {
         uint tiles_across = (uint(imageSize(surface_position).x) + TILE_SIZE - 1u) / TILE_SIZE;
         uvec4 tile = texel(tile_headers, (uint(pixel.y) / TILE_SIZE) * tiles_across + uint(pixel.x) / TILE_SIZE);
         uint entry = tile.x;
-        for (uint e = 0u; e < tile.y * light_count; ++e) {
-            uint index = tile_entry(entry + e / light_count);
+        for (uint e = 0u; e < tile.y; ++e) {
+            uint index = tile_entry(entry + e);
             vec3 xi, power;
-            uint toward_oct;
-            point_source(index, e % light_count, light_count, xi, power, toward_oct);
+            vec4 incident[3];
+            point_source(index, xi, power, incident);
             if (power == vec3(0.0)) continue;
             ++evaluations;
             vec3 ni = texel_float(points, index * POINT_TEXELS + 1u).xyz;
-            sum += source(xi, ni, decode_oct(toward_oct), power, xo, no);
+            sum += merged_source(xi, ni, power, incident, xo, no);
         }
         evaluated += tile.y;
         entry += tile.y;
-        // Both sigma points of a (node, light) in one iteration: its records are loaded once.
-        for (uint e = 0u; e < tile.z * light_count; ++e) {
-            uint index = tile_entry(entry + e / light_count);
+        // Both sigma points of a node in one iteration: its records are loaded once.
+        for (uint e = 0u; e < tile.z; ++e) {
+            uint index = tile_entry(entry + e);
             vec3 ni = decode_oct(texel(nodes, index * NODE_TEXELS + 3u).x);
             vec3 center, offset, power;
-            uint toward_oct;
-            node_sigma(index, e % light_count, light_count, ni, xo, center, offset, power, toward_oct);
+            vec4 incident[3];
+            node_sigma(index, ni, xo, center, offset, power, incident);
             if (power == vec3(0.0)) continue;
             evaluations += 2u;
-            vec3 wi = decode_oct(toward_oct);
-            sum += source(center + offset, ni, wi, power, xo, no) + source(center - offset, ni, wi, power, xo, no);
+            sum += merged_source(center + offset, ni, power, incident, xo, no)
+                 + merged_source(center - offset, ni, power, incident, xo, no);
         }
         visits += tile.z;
         entry += tile.z;
@@ -201,8 +228,8 @@ void main() {
         // that evaluate in a step do it together, whether their source is a node or a point.
         // Stack entries are a point or node and, in bits 24-28, which of its evaluations is
         // next: 0 for a fresh entry (test it first), e + 1 for evaluation e. A source's
-        // evaluations (one per light for a point, two sigma points per light for a node) are
-        // steps of this one loop, each pushing the next.
+        // evaluations (one for a point, two sigma points for a node) are steps of this one
+        // loop, each pushing the next.
         bool from_root = tile.w == WALK_FROM_ROOT;
         uint frontier_count = from_root ? 1u : tile.w;
         uint steps = evaluations;
@@ -251,21 +278,19 @@ void main() {
                     }
                 }
                 uint evaluation = next == 0u ? 0u : next - 1u;
-                uint per_light = is_point ? 1u : 2u;
-                // The rest of this source's evaluations, after this one (it took this entry's place).
-                if (evaluation + 1u < per_light * light_count) stack[top++] = item | ((evaluation + 2u) << EVALUATION_SHIFT);
-                uint k = evaluation / per_light;
-                vec3 xi, power, offset;
-                uint toward_oct;
+                // A node's second sigma point, after this one (it took this entry's place).
+                if (!is_point && evaluation == 0u) stack[top++] = item | (2u << EVALUATION_SHIFT);
+                vec3 xi, offset, power;
+                vec4 incident[3];
                 if (is_point) {
-                    point_source(index, k, light_count, xi, power, toward_oct);
+                    point_source(index, xi, power, incident);
                 } else {
-                    node_sigma(index, k, light_count, ni, xo, xi, offset, power, toward_oct);
-                    xi += (evaluation & 1u) != 0u ? -offset : offset;
+                    node_sigma(index, ni, xo, xi, offset, power, incident);
+                    xi += evaluation != 0u ? -offset : offset;
                 }
                 if (power == vec3(0.0)) continue;
                 ++evaluations;
-                sum += source(xi, ni, decode_oct(toward_oct), power, xo, no);
+                sum += merged_source(xi, ni, power, incident, xo, no);
             }
         }
     }

@@ -28,9 +28,9 @@ layout(push_constant) uniform TileCutConstants {
     uvec2 tiles;      // tiles across and down
     uvec2 pixels;     // image width and height
     uint capacity;    // entries the list buffer holds
-    uint light_count;
     uint object;      // the object whose pixels and tree these lists are of
-    uint pad;
+    uint pad0;
+    uint pad1;
 } pc;
 
 const uint END = 0xffffffffu;
@@ -88,7 +88,7 @@ uvec3 walk(vec3 tile_lo, vec3 tile_hi, bool write, uint first, uvec3 counts) {
         // Budgets: the list's evaluations against llvmpipe's loop budget (the shade pass loops
         // over them), and this walk's steps; past them a node is used whole, as the pixel walk
         // does.
-        uint evaluations = (n.x + 2u * n.y) * pc.light_count;
+        uint evaluations = n.x + 2u * n.y;
         bool must_stop = steps > MAX_CUT_STEPS || evaluations > MAX_LIST_EVALUATIONS;
         if (whole || must_stop) {
             if (write) entries[first + counts.x + n.y] = index;

@@ -172,7 +172,7 @@ pub fn run(options: &BenchOptions) -> Result<String> {
                 shadow_resolution: 1024,
                 shadow_layers: 2,
                 point_count: n,
-                light_count: 1,
+                per_light_count: 1,
             };
             crate::budget::check_frame(&ctx, &sizes)?;
         }

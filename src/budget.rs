@@ -17,13 +17,35 @@ pub struct FrameSizes {
     /// wider than [`crate::scene::SPOT_CUBE_ABOVE_DEG`] (at least 2).
     pub shadow_layers: u32,
     pub point_count: u32,
-    /// Lights: each has its own record per point and node.
-    pub light_count: u32,
+    /// Lights with their own record per point (brute force's exact sum; 0 else).
+    pub per_light_count: u32,
 }
+
+/// Bytes of one shadow-map array (of one receiver) beyond which many lights get maps of a lower
+/// resolution: 256 MiB, e.g. 64 layers of 1024² or 256 of 512² (32-bit depth).
+pub const SHADOW_MAP_BUDGET: u64 = 256 << 20;
+/// Light counts up to which `--shadow-resolution` is taken as given (and refused if too large).
+pub const FITTED_ABOVE_LIGHTS: usize = 8;
 
 impl FrameSizes {
     pub fn shadow_layers(lights: &[Light]) -> u32 {
         lights.iter().map(Light::shadow_layers).sum::<u32>().max(2)
+    }
+
+    /// The shadow-map resolution for `lights` when `requested` is asked for: the requested one
+    /// for up to [`FITTED_ABOVE_LIGHTS`] lights; for more (an environment's samples), halved
+    /// while so many layers would pass [`SHADOW_MAP_BUDGET`] (never below 128 texels: many lights
+    /// each cast a coarser shadow, and memory stays bounded by the work).
+    pub fn fitted_shadow_resolution(requested: u32, lights: &[Light]) -> u32 {
+        let layers = Self::shadow_layers(lights) as u64;
+        let mut res = requested;
+        if lights.len() <= FITTED_ABOVE_LIGHTS {
+            return res;
+        }
+        while res > 128 && res as u64 * res as u64 * 4 * layers > SHADOW_MAP_BUDGET {
+            res = (res / 2).max(128);
+        }
+        res
     }
 }
 
@@ -84,6 +106,16 @@ pub fn check_frame(ctx: &Context, s: &FrameSizes) -> Result<()> {
     let res = s.shadow_resolution;
     let shadow_usage = ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | ImageUsageFlags::SAMPLED;
     let shadow_size = (res, res, s.shadow_layers);
+    if let Some(props) = ctx.image_format_properties(shadow::SHADOW_FORMAT, shadow_usage) {
+        if s.shadow_layers > props.max_array_layers {
+            return Err(bad_input!(
+                "--light: the lights need {} shadow-map layers (1 per directional or spot light, 6 per point light); \
+                 this device allows {}",
+                s.shadow_layers,
+                props.max_array_layers
+            ));
+        }
+    }
     check_image(ctx, "--shadow-resolution", "shadow-map", shadow::SHADOW_FORMAT, shadow_usage, shadow_size, 4)?;
 
     // Device memory: the frame's targets, the shadow maps and the hierarchy (host-visible
@@ -93,7 +125,7 @@ pub fn check_frame(ctx: &Context, s: &FrameSizes) -> Result<()> {
         // entries of 4 bytes per 8×8 tile) bytes per pixel.
         (size, w as u64 * h as u64 * (16 + 4 + 3 * 16 + 17)),
         ("--shadow-resolution", res as u64 * res as u64 * s.shadow_layers as u64 * 4),
-        ("--samples", crate::hierarchy::bytes_used(s.point_count, s.light_count)),
+        ("--samples", crate::hierarchy::bytes_used(s.point_count, s.per_light_count)),
     ];
     let total: u64 = parts.iter().map(|p| p.1).sum();
     let heap = ctx.largest_device_heap();

@@ -326,7 +326,7 @@ pub struct RenderArgs {
     /// Irradiance at normal incidence: one value or R,G,B.
     #[arg(long, allow_hyphen_values = true, value_parser = rgb, value_name = "I|R,G,B", default_value = "1")]
     pub light_intensity: Vec3,
-    /// A light (repeatable, up to 8; replaces the default light): `dir:X,Y,Z[:I]` (direction toward
+    /// A light (repeatable, as many as the device has shadow-map layers; replaces the default light): `dir:X,Y,Z[:I]` (direction toward
     /// the light; I = irradiance at normal incidence, one value or R,G,B), `point:X,Y,Z[:I]`
     /// (position; I = radiant intensity, falling off with the squared distance) or
     /// `spot:X,Y,Z:TX,TY,TZ:ANGLE[:DELTA[:I]]` (a point light at X,Y,Z aimed at TX,TY,TZ, lighting a
@@ -339,6 +339,8 @@ pub struct RenderArgs {
     #[arg(long, allow_hyphen_values = true, value_parser = clap::value_parser!(u32))]
     pub samples: Option<u32>,
     /// Shadow-map resolution per light (per cube face for point lights and spots wider than 60°).
+    /// With more than 8 lights (an environment's samples) it is halved while one object's maps
+    /// would take more than 256 MiB, down to 128.
     #[arg(long, allow_hyphen_values = true, default_value_t = crate::frame_desc::DEFAULT_SHADOW_RESOLUTION, value_parser = clap::value_parser!(u32).range(16..=8192))]
     pub shadow_resolution: u32,
     /// Draw a debug view over the mesh: the sample points or the tree's boxes at --level.

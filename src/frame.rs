@@ -56,7 +56,8 @@ macro_rules! shade_inputs {
             shadow_map: &o.hierarchy.shadows.shadow_map,
             shadow_sampler: &o.hierarchy.shadows.shadow_sampler,
             point_lights: &o.hierarchy.sorted_point_lights,
-            node_lights: &o.hierarchy.node_lights,
+            point_flux: &o.hierarchy.sorted_point_flux,
+            node_flux: &o.hierarchy.node_flux,
             tile_headers: &lists.headers,
             tile_entries: &lists.entries,
             dipole_table: &o.dipole_table,
@@ -72,7 +73,7 @@ macro_rules! record_tile_cut {
         let position = &$r.targets.position;
         let params = (&o.params, &$r.frame_params);
         let object = $k as u32;
-        $r.passes.tile_cut.record($rec, params, &h.nodes, &h.sorted_points, position, lists, h.light_count, object)
+        $r.passes.tile_cut.record($rec, params, &h.nodes, &h.sorted_points, position, lists, object)
     }};
 }
 
@@ -245,7 +246,7 @@ impl Renderer {
         let mut units = Vec::new();
         for (k, o) in self.world.objects.iter().enumerate() {
             // Brute force sums (point, light) records, in ranges.
-            let records = o.hierarchy.point_count * o.hierarchy.light_count;
+            let records = o.hierarchy.point_count * o.hierarchy.per_light_count;
             let brute_force_points = desc.integration.brute_force.then_some(records);
             let first = units.len();
             units.extend(self.batching.units(desc.width, desc.height, brute_force_points));
@@ -441,10 +442,12 @@ impl HierarchyPasses {
         // Depth of every object from each light, into the layers of one shadow map.
         let shadows = &h.shadows;
         rec.scope("shadow maps", |rec| self.record_shadows(rec, casters, shadows))?;
-        // Per point and light: the light entering the surface, and its direction.
+        // Per point: the light entering the surface from every light, merged (and per light for
+        // brute force).
         rec.scope("irradiance", |rec| {
-            let (points, records, lights) = (&h.points, &h.point_lights, &shadows.lights);
-            self.irradiance.record(rec, points, records, n, lights, &shadows.shadow_map, &shadows.shadow_sampler)
+            let (points, flux, lights) = (&h.points, &h.point_flux, &shadows.lights);
+            let records = (&h.point_lights, h.per_light_count > 0);
+            self.irradiance.record(rec, points, records, flux, n, lights, &shadows.shadow_map, &shadows.shadow_sampler)
         })?;
         // A key per point along a Morton curve through the mesh's box.
         rec.scope("morton codes", |rec| self.sort.record_morton(rec, &sort, n, h.bounds()))?;

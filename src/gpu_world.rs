@@ -124,6 +124,8 @@ pub struct GpuWorld {
     pub opaque_shadows: Option<Shadows>,
     lights: Vec<Light>,
     shadow_resolution: u32,
+    /// Whether the hierarchies keep each light's own records (brute force).
+    per_light_records: bool,
 }
 
 impl GpuWorld {
@@ -139,8 +141,12 @@ impl GpuWorld {
             self.objects.truncate(world.objects.len());
         }
         let layout = |lights: &[Light]| (lights.len(), FrameSizes::shadow_layers(lights));
-        let relayout = layout(&self.lights) != layout(&desc.lights) || self.shadow_resolution != desc.shadow_resolution;
-        let light_count = desc.lights.len() as u32;
+        let per_light_records = desc.integration.brute_force;
+        let relayout = layout(&self.lights) != layout(&desc.lights)
+            || self.shadow_resolution != desc.shadow_resolution
+            || self.per_light_records != per_light_records;
+        let per_light_count = if per_light_records { desc.lights.len() as u32 } else { 0 };
+        let shadow_resolution = FrameSizes::fitted_shadow_resolution(desc.shadow_resolution, &desc.lights);
         // The sample counts first (each known before anything is made), and the frame's sizes
         // against the device.
         let mut point_counts = Vec::with_capacity(world.objects.len());
@@ -149,14 +155,14 @@ impl GpuWorld {
             point_counts.push(match (kept, object.samples) {
                 (Some(g), _) => g.hierarchy.point_count,
                 (None, Some(n)) => {
-                    hierarchy::check_point_count(ctx, n, light_count)?;
+                    hierarchy::check_point_count(ctx, n, per_light_count)?;
                     n
                 }
                 (None, None) => {
                     let mesh = object.world_mesh();
                     let m = &object.material;
                     let share = world.objects.len() as u32;
-                    hierarchy::default_point_count(ctx, &mesh, world.mm_per_unit, m, light_count, share)
+                    hierarchy::default_point_count(ctx, &mesh, world.mm_per_unit, m, per_light_count, share)
                 }
             });
         }
@@ -165,10 +171,10 @@ impl GpuWorld {
             &FrameSizes {
                 width: desc.width,
                 height: desc.height,
-                shadow_resolution: desc.shadow_resolution,
+                shadow_resolution,
                 shadow_layers: FrameSizes::shadow_layers(&desc.lights),
                 point_count: point_counts.iter().sum(),
-                light_count,
+                per_light_count,
             },
         )?;
         let diffusion = desc.integration.diffusion;
@@ -179,11 +185,8 @@ impl GpuWorld {
             // The other objects, whose shadows this one's maps must see.
             let others = bounds.iter().enumerate().filter(|&(j, _)| j != i).map(|(_, b)| *b).chain(opaque_bounds);
             let others = others.reduce(union);
-            let options = HierarchyOptions {
-                point_count,
-                shadow_resolution: desc.shadow_resolution,
-                eta: object.material.eta as f32,
-            };
+            let options =
+                HierarchyOptions { point_count, shadow_resolution, eta: object.material.eta as f32, per_light_records };
             let Some(g) = self.objects.get_mut(i) else {
                 let made_from = MadeFrom {
                     mesh: mesh.into_owned(),
@@ -239,9 +242,10 @@ impl GpuWorld {
                 write_params(&mut g.params, &mut g.dipole_table, &g.made_from, point_count)?;
             }
         }
-        self.sync_opaque(ctx, world, desc, relayout, bounds.into_iter().reduce(union))?;
+        self.sync_opaque(ctx, world, desc, (relayout, shadow_resolution), bounds.into_iter().reduce(union))?;
         self.lights = desc.lights.clone();
         self.shadow_resolution = desc.shadow_resolution;
+        self.per_light_records = per_light_records;
         Ok(())
     }
 
@@ -252,7 +256,7 @@ impl GpuWorld {
         ctx: &Context,
         world: &World,
         desc: &FrameDesc,
-        relayout: bool,
+        (relayout, shadow_resolution): (bool, u32),
         translucent: Option<(Vec3, Vec3)>,
     ) -> Result<()> {
         if self.opaque.len() > world.opaque.len() {
@@ -275,7 +279,7 @@ impl GpuWorld {
         };
         if relayout || self.opaque_shadows.is_none() {
             ctx.wait_idle()?;
-            self.opaque_shadows = Some(Shadows::new(ctx, &desc.lights, desc.shadow_resolution, 1.0)?);
+            self.opaque_shadows = Some(Shadows::new(ctx, &desc.lights, shadow_resolution, 1.0)?);
         }
         if let Some(shadows) = self.opaque_shadows.as_mut() {
             shadows.set_casters(translucent);

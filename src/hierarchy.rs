@@ -10,7 +10,7 @@
 use glam::{DVec3, Vec3};
 
 use crate::error::Result;
-use crate::gpu::{NodeLight, PointLight, SurfacePoint, TreeNode, LEAF_BIT, MAX_LIGHTS, RADIX_TILE as TILE};
+use crate::gpu::{NodeFlux, PointFlux, PointLight, SurfacePoint, TreeNode, LEAF_BIT, RADIX_TILE as TILE};
 use crate::materials::Material;
 use crate::mesh::Mesh;
 use crate::passes::sampling::prefix_bytes;
@@ -70,43 +70,52 @@ pub fn decode_oct(e: u32) -> Vec3 {
 }
 
 /// Bytes on the GPU per sample point: the point twice (unsorted, sorted), two keys, two values,
-/// a point parent and about one node (with its parent and arrival counter); and per light, the
-/// point's record twice (unsorted, sorted) and about one node's.
-const BYTES_PER_POINT: u64 = 64 * 2 + 8 * 2 + 4 * 2 + 4 + 64 + 4 + 4 + 4;
-const BYTES_PER_POINT_AND_LIGHT: u64 = 16 * 2 + 32;
+/// a point parent and about one node (with its parent and arrival counter), the merged light
+/// record twice (unsorted, sorted) and about one node's; and, for brute force only, per light
+/// the point's own record twice.
+const BYTES_PER_POINT: u64 =
+    64 * 2 + 8 * 2 + 4 * 2 + 4 + 64 + 4 + 4 + 4 + 2 * POINT_FLUX_BYTES + std::mem::size_of::<NodeFlux>() as u64;
+const BYTES_PER_POINT_AND_LIGHT: u64 = 16 * 2;
+const POINT_FLUX_BYTES: u64 = std::mem::size_of::<PointFlux>() as u64;
 
-/// The largest per-point-and-light buffer's element (the nodes' light records).
-const NODE_LIGHT_BYTES: u64 = std::mem::size_of::<NodeLight>() as u64;
-
-/// The largest sample count the device can hold with `lights` lights: each buffer within
-/// `maxStorageBufferRange`.
-pub fn max_points(ctx: &Context, lights: u32) -> u32 {
+/// The largest sample count the device can hold with `per_light_count` lights that keep their
+/// own records (brute force; 0 else): each buffer within `maxStorageBufferRange`.
+pub fn max_points(ctx: &Context, per_light_count: u32) -> u32 {
     // Storage buffers, and the shade pass's texel views of them (16-byte texels).
     let range = (ctx.limits().max_storage_buffer_range as u64).min(ctx.limits().max_texel_buffer_elements as u64 * 16);
-    // The largest per-point buffers are the points and nodes (64 bytes per element) and the
-    // nodes' light records (32 bytes per light); the radix count table is about 4 bytes per key.
-    // The walk's stack entries hold a point or node index in 24 bits (shaders/shade.frag).
-    (range / 64).min(range / (NODE_LIGHT_BYTES * lights.max(1) as u64)).min(1 << 24) as u32
+    // The largest per-point buffers are the points, nodes and node records (64 bytes per
+    // element) and, for brute force, the per-light records (16 bytes per light); the radix
+    // count table is about 4 bytes per key. The walk's stack entries hold a point or node index
+    // in 24 bits (shaders/shade.frag).
+    let per_light = range / (16 * per_light_count.max(1) as u64);
+    (range / 64).min(per_light).min(1 << 24) as u32
 }
 
-/// Checks a requested sample count against the device, for `lights` lights.
-pub fn check_point_count(ctx: &Context, n: u32, lights: u32) -> Result<()> {
-    let max = max_points(ctx, lights);
+/// Checks a requested sample count against the device, for `per_light_count` lights with their
+/// own records (brute force; 0 else).
+pub fn check_point_count(ctx: &Context, n: u32, per_light_count: u32) -> Result<()> {
+    let max = max_points(ctx, per_light_count);
     if n < 2 {
         return Err(bad_input!("--samples {n}: at least 2 sample points are needed"));
     }
     if n > max {
+        let records = if per_light_count > 0 {
+            format!(", brute force with {per_light_count} light(s): 16 per point and light")
+        } else {
+            String::new()
+        };
         return Err(bad_input!(
-            "--samples {n}: more than this device can hold with {lights} light(s) ({max}: {} MiB per storage buffer, 64 bytes per point and node, 32 per node and light)",
+            "--samples {n}: more than this device can hold ({max}: {} MiB per storage buffer, 64 bytes per point and node{records})",
             ctx.limits().max_storage_buffer_range >> 20
         ));
     }
     Ok(())
 }
 
-/// Memory the hierarchy uses on the GPU for `n` points and `lights` lights, in bytes.
-pub fn bytes_used(n: u32, lights: u32) -> u64 {
-    n as u64 * (BYTES_PER_POINT + lights as u64 * BYTES_PER_POINT_AND_LIGHT)
+/// Memory the hierarchy uses on the GPU for `n` points, with `per_light_count` lights keeping
+/// their own records (brute force; 0 else), in bytes.
+pub fn bytes_used(n: u32, per_light_count: u32) -> u64 {
+    n as u64 * (BYTES_PER_POINT + per_light_count as u64 * BYTES_PER_POINT_AND_LIGHT)
 }
 
 /// The hierarchy's buffers and images, and their sizes; the passes that fill them every frame are
@@ -119,19 +128,25 @@ pub struct Hierarchy {
     counts: Buffer,
     pub sorted_points: Buffer,
     pub nodes: Buffer,
-    /// Each light's record of each point, [point · light_count + light], unsorted then sorted.
+    /// Each light's own record of each point, [point · per_light_count + light], unsorted then
+    /// sorted: for brute force only (a single element else).
     pub(crate) point_lights: Buffer,
     pub sorted_point_lights: Buffer,
-    /// Each light's record of each node, [node · light_count + light].
-    pub node_lights: Buffer,
+    /// Every light's merged record of each point, unsorted then sorted.
+    pub(crate) point_flux: Buffer,
+    pub sorted_point_flux: Buffer,
+    /// Every light's merged record of each node.
+    pub node_flux: Buffer,
     pub node_parent: Buffer,
     pub point_parent: Buffer,
     pub arrivals: Buffer,
     /// The lights and the shadow maps fitted to this object (the irradiance pass reads them).
     pub shadows: Shadows,
     pub point_count: u32,
-    /// Lights the per-light records were made for (at creation; later light sets may not exceed it).
+    /// Lights the shadow maps were made for (at creation; later light sets must match).
     pub light_count: u32,
+    /// Lights with their own records (brute force): `light_count`, or 0.
+    pub per_light_count: u32,
     pub(crate) triangle_count: u32,
     pub(crate) index_count: u32,
     bounds: (Vec3, Vec3),
@@ -142,16 +157,19 @@ pub struct HierarchyOptions {
     pub point_count: u32,
     pub shadow_resolution: u32,
     pub eta: f32,
+    /// Keep each light's own record of each point too, for brute force's exact sum.
+    pub per_light_records: bool,
 }
 
 impl Hierarchy {
     pub fn new(ctx: &Context, mesh: &Mesh, lights: &[Light], options: &HierarchyOptions) -> Result<Hierarchy> {
         let n = options.point_count;
-        if lights.is_empty() || lights.len() > MAX_LIGHTS {
-            return Err(bad_input!("between 1 and {MAX_LIGHTS} lights are supported, {} given", lights.len()));
+        if lights.is_empty() {
+            return Err(bad_input!("--light: at least one light is needed"));
         }
         let light_count = lights.len() as u32;
-        check_point_count(ctx, n, light_count)?;
+        let per_light_count = if options.per_light_records { light_count } else { 0 };
+        check_point_count(ctx, n, per_light_count)?;
         let usage = BufferUsageFlags::STORAGE_BUFFER | BufferUsageFlags::TRANSFER_SRC | BufferUsageFlags::TRANSFER_DST;
         let storage = |name: &str, bytes: u64| Buffer::new(ctx, name, bytes, usage, MemoryLocation::GpuOnly);
         // What the shade pass reads is also read as texels (see shaders/include/points.glsl).
@@ -171,15 +189,18 @@ impl Hierarchy {
             counts: storage("radix counts", tiles * 256 * 4)?,
             sorted_points: texels("sorted points", n64 * 64)?,
             nodes: texels("tree nodes", (n64 - 1) * 64)?,
-            point_lights: storage("point light records", n64 * light_count as u64 * 16)?,
-            sorted_point_lights: texels("sorted point light records", n64 * light_count as u64 * 16)?,
-            node_lights: texels("node light records", (n64 - 1) * light_count as u64 * NODE_LIGHT_BYTES)?,
+            point_lights: storage("point light records", (n64 * per_light_count as u64).max(1) * 16)?,
+            sorted_point_lights: texels("sorted point light records", (n64 * per_light_count as u64).max(1) * 16)?,
+            point_flux: storage("point flux records", n64 * POINT_FLUX_BYTES)?,
+            sorted_point_flux: texels("sorted point flux records", n64 * POINT_FLUX_BYTES)?,
+            node_flux: texels("node flux records", (n64 - 1) * std::mem::size_of::<NodeFlux>() as u64)?,
             node_parent: storage("node parents", (n64 - 1) * 4)?,
             point_parent: storage("point parents", n64 * 4)?,
             arrivals: storage("node arrival counters", (n64 - 1) * 4)?,
             shadows: Shadows::new(ctx, lights, res, options.eta)?,
             point_count: n,
             light_count,
+            per_light_count,
             triangle_count: mesh.triangle_count() as u32,
             index_count: mesh.indices.len() as u32,
             bounds: (lo - Vec3::splat(pad), hi + Vec3::splat(pad)),
@@ -192,9 +213,6 @@ impl Hierarchy {
     /// Writes the lights and their shadow matrices (call when lights change, e.g. every frame).
     /// The number of shadow-map layers each light needs must stay what it was at creation.
     pub fn set_lights(&mut self, mesh: &Mesh, lights: &[Light]) -> Result<()> {
-        if lights.is_empty() || lights.len() > MAX_LIGHTS {
-            return Err(bad_input!("between 1 and {MAX_LIGHTS} lights are supported, {} given", lights.len()));
-        }
         if lights.len() != self.light_count as usize {
             return Err(runtime!("{} lights given, the hierarchy was made for {}", lights.len(), self.light_count));
         }
@@ -230,7 +248,9 @@ impl Hierarchy {
             sorted_points: &self.sorted_points,
             point_lights: &self.point_lights,
             sorted_point_lights: &self.sorted_point_lights,
-            light_count: self.light_count,
+            per_light_count: self.per_light_count,
+            point_flux: &self.point_flux,
+            sorted_point_flux: &self.sorted_point_flux,
         }
     }
 
@@ -243,9 +263,8 @@ impl Hierarchy {
             node_parent: &self.node_parent,
             point_parent: &self.point_parent,
             arrivals: &self.arrivals,
-            sorted_point_lights: &self.sorted_point_lights,
-            node_lights: &self.node_lights,
-            light_count: self.light_count,
+            sorted_point_flux: &self.sorted_point_flux,
+            node_flux: &self.node_flux,
         }
     }
 
@@ -258,8 +277,13 @@ impl Hierarchy {
             order: vk::download_buffer(ctx, &self.values[0], n)?,
             sorted_points: vk::download_buffer(ctx, &self.sorted_points, n)?,
             nodes: vk::download_buffer(ctx, &self.nodes, n - 1)?,
-            sorted_point_lights: vk::download_buffer(ctx, &self.sorted_point_lights, n * self.light_count as usize)?,
-            node_lights: vk::download_buffer(ctx, &self.node_lights, (n - 1) * self.light_count as usize)?,
+            sorted_point_lights: vk::download_buffer(
+                ctx,
+                &self.sorted_point_lights,
+                n * self.per_light_count as usize,
+            )?,
+            sorted_point_flux: vk::download_buffer(ctx, &self.sorted_point_flux, n)?,
+            node_flux: vk::download_buffer(ctx, &self.node_flux, n - 1)?,
         })
     }
 
@@ -307,10 +331,11 @@ pub struct Snapshot {
     pub order: Vec<u32>,
     pub sorted_points: Vec<SurfacePoint>,
     pub nodes: Vec<TreeNode>,
-    /// [point · light_count + light], sorted order.
+    /// [point · per_light_count + light], sorted order (brute force only; empty else).
     pub sorted_point_lights: Vec<PointLight>,
-    /// [node · light_count + light].
-    pub node_lights: Vec<NodeLight>,
+    /// Sorted order.
+    pub sorted_point_flux: Vec<PointFlux>,
+    pub node_flux: Vec<NodeFlux>,
 }
 
 /// A node built on the CPU in f64, for checking the GPU's.
@@ -455,15 +480,15 @@ pub fn choose_point_count(surface_area: f32, shortest_length: f32, budget: u32) 
 }
 
 /// Sample count from the material's shortest length scale (mean free path 1/σ't or diffusion
-/// length 1/σtr) and the mesh's area (in mm), within the device's budget for `lights` lights
-/// shared by `objects` objects; prints the choice and warns when points are farther apart than
+/// length 1/σtr) and the mesh's area (in mm), within the device's budget for `per_light_count`
+/// lights with their own records (brute force; 0 else) shared by `objects` objects; prints the choice and warns when points are farther apart than
 /// that length.
 pub fn default_point_count(
     ctx: &Context,
     mesh: &Mesh,
     mm_per_unit: f32,
     material: &Material,
-    lights: u32,
+    per_light_count: u32,
     objects: u32,
 ) -> u32 {
     let mm = mm_per_unit;
@@ -473,7 +498,7 @@ pub fn default_point_count(
         .filter(|c| c.transports && c.sigma_tr > 0.0)
         .map(|c| (1.0 / c.sigma_tr).min(1.0 / c.sigma_t_reduced))
         .fold(f64::INFINITY, f64::min) as f32;
-    let budget = (max_points(ctx, lights).min(1 << 18) / objects.max(1)).max(4096);
+    let budget = (max_points(ctx, per_light_count).min(1 << 18) / objects.max(1)).max(4096);
     let (n, spacing) = choose_point_count(area_mm2, shortest, budget);
     crate::note!(
         "samples: {n} points, {spacing:.3} mm apart on {area_mm2:.0} mm² (shortest of mean free path and diffusion length: {shortest:.3} mm)"

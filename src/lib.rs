@@ -9,6 +9,7 @@ pub mod cli;
 pub mod commands;
 pub mod compare;
 pub mod deform;
+pub mod environment;
 pub mod error;
 pub mod export;
 pub mod frame;

@@ -5,14 +5,14 @@
 use glam::{Mat4, Vec3};
 
 use crate::error::Result;
-use crate::gpu::{GpuLight, LightSetHeader, MAX_LIGHTS};
+use crate::gpu::{GpuLight, LightSetHeader};
 use crate::passes::shadow;
 use crate::scene::Light;
 use crate::vk::{Buffer, BufferUsageFlags, Context, Extent2D, Image, ImageUsageFlags, MemoryLocation, Sampler};
 use crate::{bad_input, runtime};
 
 pub struct Shadows {
-    /// `LightSetHeader`, then one matrix per shadow-map layer.
+    /// `LightSetHeader`, the lights, then one matrix per shadow-map layer.
     pub lights: Buffer,
     pub shadow_map: Image,
     pub shadow_sampler: Sampler,
@@ -29,15 +29,15 @@ impl Shadows {
     /// For `lights` at `resolution` texels per side (per cube face for point lights); `eta` is the
     /// receiver's relative index (its Fresnel transmittance), 1 for an opaque receiver.
     pub fn new(ctx: &Context, lights: &[Light], resolution: u32, eta: f32) -> Result<Shadows> {
-        if lights.is_empty() || lights.len() > MAX_LIGHTS {
-            return Err(bad_input!("between 1 and {MAX_LIGHTS} lights are supported, {} given", lights.len()));
+        if lights.is_empty() {
+            return Err(bad_input!("--light: at least one light is needed"));
         }
         let layers: u32 = lights.iter().map(Light::shadow_layers).sum();
         Ok(Shadows {
             lights: Buffer::new(
                 ctx,
                 "lights",
-                (std::mem::size_of::<LightSetHeader>() + 64 * layers as usize) as u64,
+                (std::mem::size_of::<LightSetHeader>() + 64 * (lights.len() + layers as usize)) as u64,
                 BufferUsageFlags::STORAGE_BUFFER,
                 MemoryLocation::CpuToGpu,
             )?,
@@ -65,16 +65,17 @@ impl Shadows {
             return Err(runtime!("{} lights given, the shadow maps were made for {}", lights.len(), self.light_count));
         }
         let radius = radius.max(1e-6) * 1.01;
-        let mut header = LightSetHeader {
+        let header = LightSetHeader {
             light_count: lights.len() as u32,
             eta: self.eta,
             // Two shadow-map texels of the orthographic maps.
             normal_offset: 2.0 * 2.0 * radius / self.resolution as f32,
-            pad: 0.0,
-            lights: [GpuLight::default(); MAX_LIGHTS],
+            // In 16-byte words after the header: 4 per light.
+            matrix_base: 4 * lights.len() as u32,
         };
+        let mut gpu_lights = Vec::with_capacity(lights.len());
         self.layer_matrices.clear();
-        for (k, light) in lights.iter().enumerate() {
+        for light in lights {
             light.validate()?;
             let mut gpu = GpuLight {
                 first_layer: self.layer_matrices.len() as u32,
@@ -94,7 +95,7 @@ impl Shadows {
                     (gpu.axis, gpu.cos_falloff_start, gpu.spot) = (axis.extend(cos_total), cos_start, 1);
                 }
             }
-            header.lights[k] = gpu;
+            gpu_lights.push(gpu);
             self.layer_matrices.extend(shadow::light_matrices(light, centre, radius, self.casters));
         }
         if self.layer_matrices.len() as u32 > self.shadow_map.layers {
@@ -104,8 +105,10 @@ impl Shadows {
                 self.shadow_map.layers
             ));
         }
+        let header_bytes = std::mem::size_of::<LightSetHeader>() as u64;
         self.lights.write(0, &[header])?;
-        self.lights.write(std::mem::size_of::<LightSetHeader>() as u64, &self.layer_matrices)?;
+        self.lights.write(header_bytes, &gpu_lights)?;
+        self.lights.write(header_bytes + 64 * lights.len() as u64, &self.layer_matrices)?;
         Ok(())
     }
 

@@ -30,9 +30,13 @@ fn build(mesh: &Mesh, lights: &[Light], n: u32) -> Snapshot {
         BufferUsageFlags::INDEX_BUFFER | BufferUsageFlags::STORAGE_BUFFER,
     )
     .unwrap();
-    let hierarchy =
-        Hierarchy::new(&ctx, mesh, lights, &HierarchyOptions { point_count: n, shadow_resolution: 1024, eta: ETA })
-            .unwrap();
+    let hierarchy = Hierarchy::new(
+        &ctx,
+        mesh,
+        lights,
+        &HierarchyOptions { point_count: n, shadow_resolution: 1024, eta: ETA, per_light_records: true },
+    )
+    .unwrap();
     let passes = HierarchyPasses::new(&ctx).unwrap();
     ctx.submit(None, |rec| passes.record(rec, &hierarchy, &vertices, &indices)).unwrap();
     let snapshot = hierarchy.download(&ctx).unwrap();
@@ -128,22 +132,25 @@ fn check_tree(s: &Snapshot) {
         }
     }
     assert!(worst <= 1e-4, "power/area differ from the CPU build by {worst:e}");
-    // Each light's records: they add up to the node's power, and the root's is that light's sum
-    // over the points.
-    let lights = s.node_lights.len() / s.nodes.len();
-    for (k, node) in s.nodes.iter().enumerate() {
-        let sum: Vec3 = s.node_lights[k * lights..(k + 1) * lights].iter().map(|l| l.power).sum();
-        assert!((sum - node.power).abs().max_element() <= 1e-4 * node.power.max_element().max(1e-30), "node {k}");
+    // Each point's lights add up to its irradiance and to its merged record (brute force's
+    // per-light records against the merged ones); the root's merged record is the points' sum.
+    let lights = s.sorted_point_lights.len() / s.sorted_points.len();
+    assert!(lights >= 1);
+    for (i, p) in s.sorted_points.iter().enumerate() {
+        let own = &s.sorted_point_lights[i * lights..(i + 1) * lights];
+        let e: Vec3 = own.iter().map(|l| l.irradiance).sum();
+        assert!((e - p.irradiance).abs().max_element() <= 1e-5 * p.irradiance.max_element().max(1e-30), "point {i}");
+        let toward: Vec3 = own.iter().map(|l| l.irradiance.x * translucent::hierarchy::decode_oct(l.toward_oct)).sum();
+        let merged = s.sorted_point_flux[i].incident[0].truncate();
+        assert!((toward - merged).abs().max_element() <= 1e-5 * e.x.max(1e-30), "point {i}: {toward} vs {merged}");
     }
-    for light in 0..lights {
-        let total: f64 = s
-            .sorted_points
-            .iter()
-            .enumerate()
-            .map(|(i, p)| (s.sorted_point_lights[i * lights + light].irradiance.x * p.area) as f64)
-            .sum();
-        assert!(rel(s.node_lights[light].power.x as f64, total) < 1e-4, "root power of light {light}");
-    }
+    let root: f64 =
+        s.sorted_points.iter().zip(&s.sorted_point_flux).map(|(p, f)| (f.incident[0].w * p.area) as f64).sum();
+    assert!(
+        rel(s.node_flux[0].incident[0].w as f64, root) < 1e-4,
+        "root flux {} vs {root}",
+        s.node_flux[0].incident[0].w
+    );
     assert!(in_leaf.iter().all(|&c| c == 1), "every point must sit in exactly one leaf (of one point)");
     let total: f64 = s.sorted_points.iter().map(|p| (p.irradiance.x * p.area) as f64).sum();
     assert!(rel(s.nodes[0].power.x as f64, total) < 1e-4, "root power {} vs sum {total}", s.nodes[0].power.x);
@@ -296,15 +303,24 @@ fn irradiance_of_two_lights_is_the_sum_of_each() {
         lit_by_b += (pb.irradiance.x > 0.0) as u32;
     }
     assert!(lit_by_b > 100, "the point light must light part of the torus");
-    // Each light's records are those of that light alone: the same points and tree, and
-    // summaries that depend on one light only.
+    // Each light's own records are those of that light alone, and the merged records of both
+    // are the sums of each alone (points and nodes).
     for (k, single) in [&only_a, &only_b].into_iter().enumerate() {
         for (i, record) in single.sorted_point_lights.iter().enumerate() {
             assert_eq!(both.sorted_point_lights[2 * i + k].irradiance, record.irradiance, "point {i}, light {k}");
         }
-        for (n, record) in single.node_lights.iter().enumerate() {
-            let mine = both.node_lights[2 * n + k];
-            assert_eq!((mine.power, mine.power_center), (record.power, record.power_center), "node {n}, light {k}");
+    }
+    let close = |x: glam::Vec4, y: glam::Vec4| (x - y).abs().max_element() <= 1e-5 * y.abs().max_element().max(1e-3);
+    for (i, ab) in both.sorted_point_flux.iter().enumerate() {
+        for c in 0..3 {
+            let sum = only_a.sorted_point_flux[i].incident[c] + only_b.sorted_point_flux[i].incident[c];
+            assert!(close(ab.incident[c], sum), "point {i} channel {c}: {:?} vs {sum:?}", ab.incident[c]);
+        }
+    }
+    for (n, ab) in both.node_flux.iter().enumerate() {
+        for c in 0..3 {
+            let sum = only_a.node_flux[n].incident[c] + only_b.node_flux[n].incident[c];
+            assert!(close(ab.incident[c], sum), "node {n} channel {c}: {:?} vs {sum:?}", ab.incident[c]);
         }
     }
 }

@@ -87,19 +87,17 @@ fn shading_params_and_tree_match_glsl() {
 
 #[test]
 fn light_records_match_glsl() {
-    use translucent::gpu::{NodeLight, PointLight};
-    let point = member_offsets("hierarchy/tree_aggregate.comp", "PointLight").expect("PointLight");
+    use translucent::gpu::{NodeFlux, PointFlux, PointLight};
+    let point = member_offsets("hierarchy/gather_points.comp", "PointLight").expect("PointLight");
     assert_eq!(point, [offset_of!(PointLight, irradiance), offset_of!(PointLight, toward_oct)].map(|o| o as u32));
     assert_eq!(size_of::<PointLight>(), 16);
-    let node = member_offsets("hierarchy/tree_aggregate.comp", "NodeLight").expect("NodeLight");
-    let rust = [
-        offset_of!(NodeLight, power),
-        offset_of!(NodeLight, toward_oct),
-        offset_of!(NodeLight, power_center),
-        offset_of!(NodeLight, spread2),
-    ];
+    let flux = member_offsets("hierarchy/tree_aggregate.comp", "PointFlux").expect("PointFlux");
+    assert_eq!(flux, [offset_of!(PointFlux, incident) as u32]);
+    assert_eq!(size_of::<PointFlux>(), 48);
+    let node = member_offsets("hierarchy/tree_aggregate.comp", "NodeFlux").expect("NodeFlux");
+    let rust = [offset_of!(NodeFlux, incident), offset_of!(NodeFlux, power_center), offset_of!(NodeFlux, spread2)];
     assert_eq!(node, rust.map(|o| o as u32));
-    assert_eq!(size_of::<NodeLight>(), 32);
+    assert_eq!(size_of::<NodeFlux>(), 64);
 }
 
 #[test]
@@ -184,9 +182,9 @@ fn push_constants_match_glsl() {
         offset_of!(TileCutConstants, tiles),
         offset_of!(TileCutConstants, pixels),
         offset_of!(TileCutConstants, capacity),
-        offset_of!(TileCutConstants, light_count),
         offset_of!(TileCutConstants, object),
-        offset_of!(TileCutConstants, pad),
+        offset_of!(TileCutConstants, pad0),
+        offset_of!(TileCutConstants, pad1),
     ];
     assert_eq!(offsets("tile_cut.comp", "TileCutConstants"), cut.map(|o| o as u32));
     // The opaque objects' passes.
@@ -222,44 +220,39 @@ fn shared_constants_are_the_rust_ones() {
     assert_eq!(value("MODEL_DIPOLE"), Some(Model::Dipole.gpu_code()));
     assert_ne!(Model::Directional.gpu_code(), Model::Dipole.gpu_code());
     assert_eq!(value("LEAF_BIT"), Some(gpu::LEAF_BIT));
-    assert_eq!(value("MAX_LIGHTS"), Some(gpu::MAX_LIGHTS as u32));
     assert_eq!(value("RADIX_TILE"), Some(gpu::RADIX_TILE));
 }
 
 #[test]
 fn lights_match_glsl() {
     use translucent::gpu::{GpuLight, LightSetHeader};
+    // lights.glsl's `light_of` reads a GpuLight as 4 vec4 words in this order: position,
+    // intensity, axis, then first_layer, cube, cos_falloff_start, spot as bits.
+    let rust: Vec<usize> = vec![
+        offset_of!(GpuLight, position),
+        offset_of!(GpuLight, intensity),
+        offset_of!(GpuLight, axis),
+        offset_of!(GpuLight, first_layer),
+        offset_of!(GpuLight, cube),
+        offset_of!(GpuLight, cos_falloff_start),
+        offset_of!(GpuLight, spot),
+    ];
+    assert_eq!(rust, [0, 16, 32, 48, 52, 56, 60]);
+    assert_eq!(size_of::<GpuLight>(), 64);
     // Every shader that reads the lights (through light_at).
     for shader in ["hierarchy/irradiance.comp", "shade.frag", "diffuse.frag"] {
-        let light = member_offsets(shader, "GpuLight").expect("GpuLight");
-        let rust: Vec<u32> = [
-            offset_of!(GpuLight, position),
-            offset_of!(GpuLight, intensity),
-            offset_of!(GpuLight, axis),
-            offset_of!(GpuLight, first_layer),
-            offset_of!(GpuLight, cube),
-            offset_of!(GpuLight, cos_falloff_start),
-            offset_of!(GpuLight, spot),
-        ]
-        .iter()
-        .map(|&o| o as u32)
-        .collect();
-        assert_eq!(light, rust, "{shader}");
-        let set = member_offsets(shader, "LightSet").expect("LightSet");
+        let set = member_offsets(shader, "Lights").expect("Lights");
         let rust: Vec<u32> = [
             offset_of!(LightSetHeader, light_count),
             offset_of!(LightSetHeader, eta),
             offset_of!(LightSetHeader, normal_offset),
-            offset_of!(LightSetHeader, pad),
-            offset_of!(LightSetHeader, lights),
+            offset_of!(LightSetHeader, matrix_base),
+            size_of::<LightSetHeader>(),
         ]
         .iter()
         .map(|&o| o as u32)
         .collect();
         assert_eq!(set, rust, "{shader}");
     }
-    assert_eq!(size_of::<GpuLight>(), 64);
-    // The layer matrices follow the header: a multiple of 16 bytes (std430's mat4 alignment).
-    assert_eq!(size_of::<LightSetHeader>(), 16 + 64 * translucent::gpu::MAX_LIGHTS);
-    assert_eq!(size_of::<LightSetHeader>() % 16, 0);
+    assert_eq!(size_of::<LightSetHeader>(), 16);
 }

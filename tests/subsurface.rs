@@ -452,11 +452,13 @@ fn sum_of(parts: &[Vec<[f32; 4]>]) -> Vec<[f32; 4]> {
     sum
 }
 
-/// Lights add: under the directional dipole, which is not linear in the light's direction, a
-/// render of several lights equals the sum of each alone, with the tree and with brute force,
-/// because every light is its own source (the walk's choice of nodes does not depend on them).
-/// One irradiance with a mean direction made a directional and a point light differ from their
-/// sum by 3.3%.
+/// Lights add. Brute force sums every (point, light) pair, so under both models a render of
+/// several lights equals the sum of each alone. The tree carries all lights in one merged record
+/// per point and node (PointFlux): exact for the classical dipole, which does not depend on the
+/// light's direction, and for the directional dipole exact except through the real source's
+/// distance dr and the clamp at 0 (measured: 0.56% for this directional light from above and a
+/// point light from the other side, within 1%; one irradiance with one unit mean direction, as
+/// first tried, was 3.3% off).
 #[test]
 fn lights_add_exactly_under_both_models() {
     let fixed = SceneSettings { mesh: Some("sphere".into()), ..Default::default() };
@@ -473,12 +475,15 @@ fn lights_add_exactly_under_both_models() {
             let parts = [render_with(&[a]), render_with(&[b])];
             let error = relative_rmse(&both, &sum_of(&parts));
             println!("{model:?} {method}: two lights against the sum of each alone: relative RMSE {error:.2e}");
-            assert!(error <= 1e-3, "{model:?} {method}: {error}");
+            let merged = model == Model::Directional && !brute_force;
+            assert!(error <= if merged { 1e-2 } else { 1e-3 }, "{model:?} {method}: {error}");
         }
     }
 }
 
-/// Eight lights of both kinds, the tree and the directional dipole: still the sum of each alone.
+/// Eight lights of both kinds from every side, the tree and the directional dipole: the merged
+/// records stay within 1% of the sum of each alone (measured 0.70%; lights from every side are
+/// the merged records' worst case, see tests/lights.rs for lights from one side).
 #[test]
 fn eight_lights_add_exactly() {
     let lights = [
@@ -496,7 +501,7 @@ fn eight_lights_add_exactly() {
     let parts: Vec<Vec<[f32; 4]>> = lights.iter().map(|l| render(&settings(&lit(&fixed, &[*l])))).collect();
     let error = relative_rmse(&together, &sum_of(&parts));
     println!("eight lights against the sum of each alone: relative RMSE {error:.2e}");
-    assert!(error <= 1e-3, "{error}");
+    assert!(error <= 1e-2, "{error}");
 }
 
 /// Signed mean difference per channel, Σ(a − b) / Σ b over the covered pixels.

@@ -7,8 +7,8 @@
 // to arrive stops and the second, which knows both children are done, sums them. Sums are always
 // left + right, so the result does not depend on which thread arrives second.
 // A node's geometry (area, area-weighted centre, normal, bounds) does not depend on the lights;
-// each light gets its own NodeLight (power, power centre and spread, direction), so that what a
-// node contributes is a sum over lights of terms that each depend on one light only.
+// its NodeFlux sums its points' merged light records (PointFlux), one record whatever the number
+// of lights.
 #include "points.glsl"
 layout(local_size_x = 64) in;
 layout(std430, binding = 0) readonly buffer Sorted { SurfacePoint points[]; };
@@ -16,9 +16,9 @@ layout(std430, binding = 1) queuefamilycoherent buffer Nodes { TreeNode nodes[];
 layout(std430, binding = 2) readonly buffer NodeParents { uint node_parent[]; };
 layout(std430, binding = 3) readonly buffer PointParents { uint point_parent[]; };
 layout(std430, binding = 4) queuefamilycoherent buffer Arrivals { uint arrivals[]; };
-layout(std430, binding = 5) readonly buffer SortedPointLights { PointLight point_lights[]; };
-layout(std430, binding = 6) queuefamilycoherent buffer NodeLights { NodeLight node_lights[]; };
-layout(push_constant) uniform TreeConstants { uint point_count; uint light_count; } pc;
+layout(std430, binding = 5) readonly buffer SortedPointFluxes { PointFlux point_flux[]; };
+layout(std430, binding = 6) queuefamilycoherent buffer NodeFluxes { NodeFlux node_flux[]; };
+layout(push_constant) uniform TreeConstants { uint point_count; } pc;
 
 const uint NONE = 0xffffffffu;
 
@@ -47,25 +47,15 @@ Summary of_child(uint child) {
     return s;
 }
 
-struct LightSummary { vec3 power; vec3 toward; vec3 power_center; float spread2; };
-
-LightSummary light_of_child(uint child, uint k) {
-    LightSummary s;
+NodeFlux flux_of_child(uint child) {
     if ((child & LEAF_BIT) != 0u) {
         uint i = child & ~LEAF_BIT;
-        PointLight l = point_lights[i * pc.light_count + k];
-        s.power = l.irradiance * points[i].area;
-        s.toward = decode_oct(l.toward_oct);
-        s.power_center = points[i].position;
-        s.spread2 = 0.0;
-    } else {
-        NodeLight l = node_lights[child * pc.light_count + k];
-        s.power = l.power;
-        s.toward = decode_oct(l.toward_oct);
-        s.power_center = l.power_center;
-        s.spread2 = l.spread2;
+        PointFlux p = point_flux[i];
+        float area = points[i].area;
+        return NodeFlux(vec4[3](p.incident[0] * area, p.incident[1] * area, p.incident[2] * area),
+                        points[i].position, 0.0);
     }
-    return s;
+    return node_flux[child];
 }
 
 float luminance(vec3 c) { return dot(c, vec3(0.2126, 0.7152, 0.0722)); }
@@ -95,26 +85,20 @@ void main() {
         nodes[node].normal_oct = encode_oct(dot(normal_sum, normal_sum) > 0.0 ? normalize(normal_sum) : vec3(0.0, 0.0, 1.0));
         nodes[node].light_oct = dot(light_sum, light_sum) > 0.0 ? encode_oct(normalize(light_sum)) : 0u;
         nodes[node].box_half = pack_box(min(a.lo, b.lo), max(a.hi, b.hi));
-        for (uint k = 0u; k < pc.light_count; ++k) {
-            LightSummary la = light_of_child(left, k), lb = light_of_child(right, k);
-            float pa = luminance(la.power), pb = luminance(lb.power);
-            NodeLight merged;
-            merged.power = la.power + lb.power;
-            if (pa + pb > 0.0) {
-                merged.power_center = (la.power_center * pa + lb.power_center * pb) / (pa + pb);
-                // Parallel axes: each child's spread about its own centre plus its offset.
-                merged.spread2 = (pa * (la.spread2 + dot(squared(la.power_center - merged.power_center), vec3(1.0)))
-                                + pb * (lb.spread2 + dot(squared(lb.power_center - merged.power_center), vec3(1.0))))
-                               / (pa + pb);
-                vec3 toward = la.toward * pa + lb.toward * pb;
-                merged.toward_oct = encode_oct(dot(toward, toward) > 0.0 ? normalize(toward) : vec3(0.0, 0.0, 1.0));
-            } else {
-                merged.power_center = center;
-                merged.spread2 = 0.0;
-                merged.toward_oct = encode_oct(vec3(0.0, 0.0, 1.0));
-            }
-            node_lights[node * pc.light_count + k] = merged;
+        NodeFlux fa = flux_of_child(left), fb = flux_of_child(right);
+        NodeFlux merged;
+        for (uint c = 0u; c < 3u; ++c) merged.incident[c] = fa.incident[c] + fb.incident[c];
+        if (wa + wb > 0.0) {
+            merged.power_center = (fa.power_center * wa + fb.power_center * wb) / (wa + wb);
+            // Parallel axes: each child's spread about its own centre plus its offset.
+            merged.spread2 = (wa * (fa.spread2 + dot(squared(fa.power_center - merged.power_center), vec3(1.0)))
+                            + wb * (fb.spread2 + dot(squared(fb.power_center - merged.power_center), vec3(1.0))))
+                           / (wa + wb);
+        } else {
+            merged.power_center = center;
+            merged.spread2 = 0.0;
         }
+        node_flux[node] = merged;
         node = node_parent[node];
     }
 }

@@ -98,17 +98,31 @@ struct DirpoleGeometry {
     vec3 wv;      // virtual source direction
 };
 
-DirpoleGeometry dirpole_geometry(vec3 xi, vec3 ni, vec3 wi, vec3 xo, vec3 no, float eta) {
+// The geometry for a refracted direction w12 given directly: a light's own (unit), or a merged
+// record's irradiance-weighted mean of several (PointFlux in points.glsl; shorter than 1).
+DirpoleGeometry dirpole_geometry_refracted(vec3 xi, vec3 ni, vec3 w12, vec3 xo, vec3 no) {
     DirpoleGeometry g;
     g.x = xo - xi;
     g.r2 = dot(g.x, g.x);
-    g.w12 = refract_in(wi, ni, eta);
+    g.w12 = w12;
     // Modified tangent plane: the part of ni normal to x; ni where x is zero or parallel to ni.
     vec3 perp = ni - g.x * (dot(g.x, ni) / max(g.r2, 1e-30));
     g.ni_star = (g.r2 > 0.0 && dot(perp, perp) > 1e-12) ? normalize(perp) : ni;
     g.mu0 = -dot(no, g.w12);
     g.wv = g.w12 - 2.0 * dot(g.w12, g.ni_star) * g.ni_star;
     return g;
+}
+
+// The same geometry for another refracted direction (the channel-independent parts kept).
+DirpoleGeometry with_refracted(DirpoleGeometry g, vec3 w12, vec3 no) {
+    g.w12 = w12;
+    g.mu0 = -dot(no, w12);
+    g.wv = w12 - 2.0 * dot(w12, g.ni_star) * g.ni_star;
+    return g;
+}
+
+DirpoleGeometry dirpole_geometry(vec3 xi, vec3 ni, vec3 wi, vec3 xo, vec3 no, float eta) {
+    return dirpole_geometry_refracted(xi, ni, refract_in(wi, ni, eta), xo, no);
 }
 
 // Real and virtual source terms of one channel; Sd = max(0, real - virtual).

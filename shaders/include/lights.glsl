@@ -12,13 +12,32 @@ struct GpuLight {
     float cos_falloff_start; // spot lights: cos(cone angle - delta), where the falloff begins
     uint spot;       // 1: a spot light (its falloff applies)
 };
-struct LightSet {
+// The light set's buffer (binding LIGHTS_BINDING, defined by the shader before it includes this
+// file): a header (mirrored by LightSetHeader), then `light_count` lights as 4 vec4 each (GpuLight
+// in order: position, intensity, axis, then first_layer, cube, cos_falloff_start, spot as bits),
+// then from `matrix_base` one mat4 per shadow-map layer. As many lights as memory holds: one
+// runtime array of words, since a block may end in only one.
+#ifdef LIGHTS_BINDING
+layout(std430, binding = LIGHTS_BINDING) readonly buffer Lights {
     uint light_count;
     float eta;            // relative index of the medium, for Ft
     float normal_offset;  // shadow lookup offset along the normal, scene units
-    float pad;
-    GpuLight lights[MAX_LIGHTS];
-};
+    uint matrix_base;     // the first layer matrix, in vec4 words
+    vec4 words[];
+} light_set;
+
+GpuLight light_of(uint k) {
+    uint b = 4u * k;
+    uvec4 bits = floatBitsToUint(light_set.words[b + 3u]);
+    return GpuLight(light_set.words[b], light_set.words[b + 1u], light_set.words[b + 2u], bits.x, bits.y,
+                    uintBitsToFloat(bits.z), bits.w);
+}
+
+mat4 layer_matrix(uint layer) {
+    uint b = light_set.matrix_base + 4u * layer;
+    return mat4(light_set.words[b], light_set.words[b + 1u], light_set.words[b + 2u], light_set.words[b + 3u]);
+}
+#endif
 
 // Cube face of a direction from a point light: +x, -x, +y, -y, +z, -z (as in src/passes/shadow.rs).
 uint cube_face(vec3 d) {

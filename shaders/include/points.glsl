@@ -13,16 +13,29 @@ struct SurfacePoint {
     vec3 irradiance;   // W/m² per RGB entering the surface: I cos Ft(eta) visibility, summed over lights
     float pad0;
     vec3 light_dir;    // irradiance-weighted mean direction toward the lights (unit, or 0 if unlit;
-                       // for views and tools: shading uses each light's own PointLight)
+                       // for views and tools: shading uses PointFlux)
     float pad1;
 };
 
-// What one light brings to one point (16 bytes), at [point · light_count + light]. Each light is
-// its own source: the directional dipole is not linear in the light's direction, so lights
-// summed into one irradiance with a mean direction would not add up.
+// What one light brings to one point (16 bytes), at [point · light_count + light]: kept only for
+// brute force, the exact sum over lights that the merged records below are measured against.
 struct PointLight {
     vec3 irradiance;   // entering the surface from this light (0 where it does not reach)
     uint toward_oct;   // unit direction toward this light, octahedral 2×16-bit snorm
+};
+
+// What every light together brings to one point (48 bytes), one record whatever the number of
+// lights: per channel c, incident[c].xyz = Σ_k E_k,c ωi,k (the irradiance-weighted sum of the
+// directions toward the lights, world space) and incident[c].w = Σ_k E_k,c cos θt,k (of the
+// refracted directions' cosines to the normal); E_c = Σ_k E_k,c is the point's irradiance.
+// Refraction at a normal n is linear in ωi along the surface, ω12 = -(ωi - (ωi·n)n)/η - n cos θt,
+// so these give Σ_k E_k,c ω12,k exactly at the point's own normal (and, for a node, the same
+// lights refracted at the node's normal). The directional dipole's source S'(x, ω12, r) is
+// affine in ω12 for fixed x and r, and its virtual source is linear in ω12, so
+// E_c · S'(x, Σ E ω12 / E_c, r) is the exact sum over lights except through the real source's
+// distance dr (which depends on ω12) and the clamp at 0.
+struct PointFlux {
+    vec4 incident[3];
 };
 
 // A node of the Karras (HPG 2012) binary radix tree over the Morton-sorted points (64 bytes).
@@ -41,13 +54,12 @@ struct TreeNode {
     uint point_count;
 };
 
-// What one light brings to one node (32 bytes), at [node · light_count + light]: the node used
-// whole is one source per light, at that light's power centre.
-struct NodeLight {
-    vec3 power;        // sum of this light's irradiance × area per RGB
-    uint toward_oct;   // power-weighted mean direction toward the light, octahedral
-    vec3 power_center; // power-weighted mean position (area-weighted where the power is 0)
-    float spread2;     // power-weighted mean squared distance of the points from power_center
+// What every light together brings to one node (64 bytes): the node used whole is one merged
+// source (two sigma points) at its power centre.
+struct NodeFlux {
+    vec4 incident[3];  // per channel: PointFlux's sums times each point's area
+    vec3 power_center; // luminance-of-power-weighted mean position (area-weighted where unlit)
+    float spread2;     // the same weights' mean squared distance of the points from power_center
 };
 
 // The same records read as RGBA32UI texels (usamplerBuffer views of the same buffers, for the
@@ -55,11 +67,12 @@ struct NodeLight {
 // Each record is a whole number of texels, in the order of its fields above:
 // SurfacePoint: 0 position, area; 1 normal, triangle; 2 irradiance; 3 light_dir.
 // TreeNode: 0 power, area; 1 center, left; 2 box_half, right; 3 normal_oct, light_oct,
-// first_point, point_count. PointLight: 0 irradiance, toward_oct. NodeLight: 0 power,
-// toward_oct; 1 power_center, spread2.
+// first_point, point_count. PointLight: 0 irradiance, toward_oct. PointFlux: 0-2 incident.
+// NodeFlux: 0-2 incident; 3 power_center, spread2.
 const uint POINT_TEXELS = 4u;
 const uint NODE_TEXELS = 4u;
-const uint NODE_LIGHT_TEXELS = 2u;
+const uint POINT_FLUX_TEXELS = 3u;
+const uint NODE_FLUX_TEXELS = 4u;
 uvec4 texel(usamplerBuffer records, uint index) { return texelFetch(records, int(index)); }
 vec4 texel_float(usamplerBuffer records, uint index) { return uintBitsToFloat(texelFetch(records, int(index))); }
 

@@ -12,9 +12,6 @@ pub const MODEL_DIPOLE: u32 = 1;
 /// Set in a tree node's child index when the child is a point (index into the sorted points).
 pub const LEAF_BIT: u32 = 0x8000_0000;
 
-/// Lights in a `LightSet` (lights.glsl).
-pub const MAX_LIGHTS: usize = 8;
-
 /// Keys per tile of the radix sort (radix.glsl).
 pub const RADIX_TILE: u32 = 256;
 
@@ -38,7 +35,6 @@ pub const GLSL_CONSTANTS: &[(&str, u32)] = &[
     ("MODEL_DIRECTIONAL", MODEL_DIRECTIONAL),
     ("MODEL_DIPOLE", MODEL_DIPOLE),
     ("LEAF_BIT", LEAF_BIT),
-    ("MAX_LIGHTS", MAX_LIGHTS as u32),
     ("RADIX_TILE", RADIX_TILE),
     ("TILE_SIZE", TILE_SIZE),
     ("WALK_FROM_ROOT", WALK_FROM_ROOT),

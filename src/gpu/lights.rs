@@ -3,8 +3,6 @@
 use bytemuck::{Pod, Zeroable};
 use glam::Vec4;
 
-use super::MAX_LIGHTS;
-
 /// Mirrors `GpuLight` in shaders/include/lights.glsl.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
@@ -22,13 +20,14 @@ pub struct GpuLight {
     pub spot: u32,
 }
 
-/// Mirrors `LightSet` in shaders/include/lights.glsl; the layer matrices follow it in the buffer.
+/// Mirrors the header of the `Lights` block in shaders/include/lights.glsl; `light_count`
+/// [`GpuLight`]s follow it in the buffer, then from `matrix_base` (in 16-byte words after the
+/// header) one matrix per shadow-map layer.
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct LightSetHeader {
     pub light_count: u32,
     pub eta: f32,
     pub normal_offset: f32,
-    pub pad: f32,
-    pub lights: [GpuLight; MAX_LIGHTS],
+    pub matrix_base: u32,
 }

@@ -118,8 +118,8 @@ pub struct TileCutConstants {
     pub pixels: [u32; 2],
     /// Entries the list buffer holds.
     pub capacity: u32,
-    pub light_count: u32,
     /// The object whose pixels (G-buffer position w = object + 1) and tree the lists are of.
     pub object: u32,
-    pub pad: u32,
+    pub pad0: u32,
+    pub pad1: u32,
 }

@@ -1,7 +1,7 @@
 //! points.glsl: the surface samples, what each light brings to each, and the tree's nodes.
 
 use bytemuck::{Pod, Zeroable};
-use glam::Vec3;
+use glam::{Vec3, Vec4};
 
 /// Mirrors `SurfacePoint` in shaders/include/points.glsl (64 bytes).
 #[repr(C)]
@@ -17,7 +17,8 @@ pub struct SurfacePoint {
     pub pad1: f32,
 }
 
-/// Mirrors `PointLight` in shaders/include/points.glsl (16 bytes): one light at one point.
+/// Mirrors `PointLight` in shaders/include/points.glsl (16 bytes): one light at one point (kept
+/// for brute force only).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct PointLight {
@@ -25,12 +26,20 @@ pub struct PointLight {
     pub toward_oct: u32,
 }
 
-/// Mirrors `NodeLight` in shaders/include/points.glsl (32 bytes): one light over one node.
+/// Mirrors `PointFlux` in shaders/include/points.glsl (48 bytes): every light at one point, per
+/// channel c `incident[c]` = (Σ_k E_k,c ωi,k, Σ_k E_k,c cos θt,k).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
-pub struct NodeLight {
-    pub power: Vec3,
-    pub toward_oct: u32,
+pub struct PointFlux {
+    pub incident: [Vec4; 3],
+}
+
+/// Mirrors `NodeFlux` in shaders/include/points.glsl (64 bytes): every light over one node, per
+/// channel PointFlux's sums times the points' areas, and the power centre and spread.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct NodeFlux {
+    pub incident: [Vec4; 3],
     pub power_center: Vec3,
     pub spread2: f32,
 }

@@ -1,6 +1,6 @@
 //! Irradiance at each point from every light, with shadow-map visibility and Fresnel transmittance.
-//! Reads: lights, shadow map. Writes: points (irradiance, mean light direction), each light's
-//! record of each point.
+//! Reads: lights, shadow map. Writes: points (irradiance, mean light direction), every light's
+//! merged record of each point, and (for brute force) each light's own.
 
 use crate::error::Result;
 use crate::vk::{Bind, Buffer, Context, Image, Pipeline, Recorder, Sampler};
@@ -19,7 +19,8 @@ impl IrradiancePass {
         &self,
         rec: &mut Recorder,
         points: &Buffer,
-        point_lights: &Buffer,
+        (point_lights, per_light_records): (&Buffer, bool),
+        point_flux: &Buffer,
         point_count: u32,
         lights: &Buffer,
         shadow_map: &Image,
@@ -27,8 +28,14 @@ impl IrradiancePass {
     ) -> Result<()> {
         rec.dispatch(
             &self.pipeline,
-            &[Bind::Write(points), Bind::Read(lights), Bind::Sampled(shadow_map, sampler), Bind::Write(point_lights)],
-            &point_count.to_le_bytes(),
+            &[
+                Bind::Write(points),
+                Bind::Read(lights),
+                Bind::Sampled(shadow_map, sampler),
+                Bind::Write(point_lights),
+                Bind::Write(point_flux),
+            ],
+            bytemuck::bytes_of(&[point_count, per_light_records as u32]),
             [point_count.div_ceil(64), 1, 1],
         )
     }

@@ -47,8 +47,10 @@ pub struct ShadeInputs<'a> {
     pub lights: &'a Buffer,
     pub shadow_map: &'a Image,
     pub shadow_sampler: &'a Sampler,
+    /// Each light's own record of each point (brute force only).
     pub point_lights: &'a Buffer,
-    pub node_lights: &'a Buffer,
+    pub point_flux: &'a Buffer,
+    pub node_flux: &'a Buffer,
     /// The classical dipole's Sd table (`physics::dipole::SdTable`).
     pub dipole_table: &'a Buffer,
     /// The tile-cut pass's lists (headers and entries).
@@ -243,13 +245,14 @@ impl ShadePass {
             Bind::Read(inputs.lights),
             Bind::Sampled(inputs.shadow_map, inputs.shadow_sampler),
             Bind::Texels(inputs.point_lights),
-            Bind::Texels(inputs.node_lights),
+            Bind::Texels(inputs.node_flux),
             Bind::StorageImageRead(inputs.position),
             Bind::StorageImageRead(inputs.normal),
             Bind::Texels(inputs.tile_headers),
             Bind::Texels(inputs.tile_entries),
             Bind::Texels(inputs.dipole_table),
             Bind::Uniform(inputs.frame_params),
+            Bind::Texels(inputs.point_flux),
         ];
         let mut c = *constants;
         c.point_range = glam::UVec4::new(unit.first_point, unit.point_count, unit.object, 0);

@@ -14,9 +14,13 @@ pub struct SortBuffers<'a> {
     pub values: [&'a Buffer; 2],
     pub counts: &'a Buffer,
     pub sorted_points: &'a Buffer,
+    /// Each light's own record of each point, for brute force only (`per_light_count` 0 else).
     pub point_lights: &'a Buffer,
     pub sorted_point_lights: &'a Buffer,
-    pub light_count: u32,
+    pub per_light_count: u32,
+    /// Every light's merged record of each point.
+    pub point_flux: &'a Buffer,
+    pub sorted_point_flux: &'a Buffer,
 }
 
 pub struct SortPass {
@@ -86,8 +90,10 @@ impl SortPass {
                 Bind::Write(b.sorted_points),
                 Bind::Read(b.point_lights),
                 Bind::Write(b.sorted_point_lights),
+                Bind::Read(b.point_flux),
+                Bind::Write(b.sorted_point_flux),
             ],
-            bytemuck::bytes_of(&[n, b.light_count]),
+            bytemuck::bytes_of(&[n, b.per_light_count]),
             [n.div_ceil(64), 1, 1],
         )
     }

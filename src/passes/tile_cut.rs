@@ -103,7 +103,6 @@ impl TileCutPass {
         points: &Buffer,
         position: &Image,
         lists: &TileLists,
-        light_count: u32,
         object: u32,
     ) -> Result<()> {
         rec.fill_buffer(&lists.allocation, 0)?;
@@ -111,9 +110,9 @@ impl TileCutPass {
             tiles: lists.tiles,
             pixels: lists.pixels,
             capacity: lists.capacity.min(u32::MAX as u64) as u32,
-            light_count,
             object,
-            pad: 0,
+            pad0: 0,
+            pad1: 0,
         };
         rec.dispatch(
             &self.pipeline,

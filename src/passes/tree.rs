@@ -12,9 +12,8 @@ pub struct TreeBuffers<'a> {
     pub node_parent: &'a Buffer,
     pub point_parent: &'a Buffer,
     pub arrivals: &'a Buffer,
-    pub sorted_point_lights: &'a Buffer,
-    pub node_lights: &'a Buffer,
-    pub light_count: u32,
+    pub sorted_point_flux: &'a Buffer,
+    pub node_flux: &'a Buffer,
 }
 
 pub struct TreePass {
@@ -54,10 +53,10 @@ impl TreePass {
                 Bind::Read(b.node_parent),
                 Bind::Read(b.point_parent),
                 Bind::Write(b.arrivals),
-                Bind::Read(b.sorted_point_lights),
-                Bind::Write(b.node_lights),
+                Bind::Read(b.sorted_point_flux),
+                Bind::Write(b.node_flux),
             ],
-            bytemuck::bytes_of(&[n, b.light_count]),
+            bytemuck::bytes_of(&n),
             [n.div_ceil(64), 1, 1],
         )
     }

@@ -316,9 +316,6 @@ pub fn render_settings(
             }
         }
     }
-    if lights.len() > crate::gpu::MAX_LIGHTS {
-        return Err(bad_input!("{shown}: {} lights: at most {} are rendered", lights.len(), crate::gpu::MAX_LIGHTS));
-    }
     let camera = scene.camera.clone().unwrap_or_else(|| CameraDesc {
         eye: DVec3::ZERO,
         target: DVec3::Z,

@@ -53,6 +53,9 @@ pub fn upload_buffer<T: bytemuck::Pod>(
 
 /// Copies `count` elements of a device buffer back to the host (tests, tools; not per frame).
 pub fn download_buffer<T: bytemuck::Pod>(ctx: &Context, buffer: &Buffer, count: usize) -> crate::Result<Vec<T>> {
+    if count == 0 {
+        return Ok(Vec::new());
+    }
     let bytes = (count * std::mem::size_of::<T>()) as u64;
     let staging = Buffer::new(
         ctx,

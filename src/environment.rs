@@ -1,0 +1,332 @@
+//! Environment light: radiance arriving from every direction, read from an image (latitude-
+//! longitude 2:1, or pbrt-v4's square equal-area octahedral map) or constant, and sampled into K
+//! directional lights whose directions are stratified by the map's energy. Each sample is then an
+//! ordinary shadowed directional light, so the irradiance at every point integrates the map with
+//! visibility and converges as K grows.
+//!
+//! Directions: world space, +y up. A latitude-longitude map follows Mitsuba 3's `envmap` (so that
+//! `export mitsuba` can hand it the same file): u = (1 + atan2(x, −z)/π)/2 across, v = acos(y)/π
+//! down. An equal-area octahedral map follows pbrt-v4's `EqualAreaSquareToSphere` (Clarberg 2008)
+//! in the light's own frame, z up there; pbrt scenes give the frame with the light's transform.
+
+use std::f64::consts::PI;
+use std::sync::Arc;
+
+use glam::{DMat3, DVec3, Mat3, Vec3};
+
+use crate::error::Result;
+use crate::scene::Light;
+use crate::{bad_input, world::MAX_TEXTURE_SIDE, world::MAX_TEXTURE_TEXELS};
+
+/// How an image's texels map to directions.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Layout {
+    /// 2:1, Mitsuba's convention (see the module's notes).
+    LatLong,
+    /// Square, pbrt-v4's equal-area octahedral map.
+    Octahedral,
+}
+
+/// Radiance per direction.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Radiance {
+    Constant(Vec3),
+    Image { width: u32, height: u32, layout: Layout, texels: Arc<Vec<[f32; 3]>> },
+}
+
+/// The default number of directions an environment is sampled in (`--env-samples`).
+pub const DEFAULT_SAMPLES: u32 = 64;
+
+/// An environment light and its samples.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Environment {
+    /// Where it came from, for messages.
+    pub name: String,
+    pub radiance: Radiance,
+    /// Multiplies the radiance.
+    pub scale: f32,
+    /// From the map's frame to the world (a rotation).
+    pub to_world: Mat3,
+    /// Directions sampled.
+    pub samples: u32,
+}
+
+impl Environment {
+    /// Reads an EXR or Radiance HDR (linear) or a PNG (sRGB, decoded to linear) map; `shown`
+    /// names it in messages. 2:1 images are latitude-longitude, square ones equal-area
+    /// octahedral; every texel must be finite and ≥ 0.
+    pub fn load(path: &std::path::Path, shown: &str) -> Result<Radiance> {
+        let meta = std::fs::metadata(path).map_err(|e| bad_input!("{shown}: {e}"))?;
+        if !meta.is_file() {
+            return Err(bad_input!("{shown}: not a regular file"));
+        }
+        let ext = path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).unwrap_or_default();
+        let reader = image::ImageReader::open(path).map_err(|e| bad_input!("{shown}: {e}"))?;
+        let reader = reader.with_guessed_format().map_err(|e| bad_input!("{shown}: {e}"))?;
+        let (width, height) = reader.into_dimensions().map_err(|e| bad_input!("{shown}: not an image: {e}"))?;
+        if width == 0
+            || height == 0
+            || width > MAX_TEXTURE_SIDE
+            || height > MAX_TEXTURE_SIDE
+            || width as u64 * height as u64 > MAX_TEXTURE_TEXELS
+        {
+            return Err(bad_input!(
+                "{shown}: {width}x{height}: an environment map's sides must be between 1 and {MAX_TEXTURE_SIDE}, with at most {MAX_TEXTURE_TEXELS} texels"
+            ));
+        }
+        let layout = if width == 2 * height {
+            Layout::LatLong
+        } else if width == height {
+            Layout::Octahedral
+        } else {
+            return Err(bad_input!(
+                "{shown}: {width}x{height}: an environment map is 2:1 (latitude-longitude) or square (equal-area octahedral)"
+            ));
+        };
+        let img = image::open(path).map_err(|e| bad_input!("{shown}: not an image: {e}"))?.into_rgb32f();
+        let srgb = ext == "png";
+        let decode = |c: f32| {
+            if !srgb {
+                c
+            } else if c <= 0.04045 {
+                c / 12.92
+            } else {
+                ((c + 0.055) / 1.055).powf(2.4)
+            }
+        };
+        let texels: Vec<[f32; 3]> = img.pixels().map(|p| [decode(p[0]), decode(p[1]), decode(p[2])]).collect();
+        if let Some((i, t)) = texels.iter().enumerate().find(|(_, t)| !t.iter().all(|c| c.is_finite() && *c >= 0.0)) {
+            let (x, y) = (i as u32 % width, i as u32 / width);
+            return Err(bad_input!("{shown}: texel ({x}, {y}) is {t:?}: radiance must be finite and ≥ 0"));
+        }
+        Ok(Radiance::Image { width, height, layout, texels: Arc::new(texels) })
+    }
+
+    /// Checks the scale, the rotation, the sample count and that the map sends any light.
+    pub fn validate(&self) -> Result<()> {
+        if !(self.scale.is_finite() && self.scale >= 0.0) {
+            return Err(bad_input!("--env-scale {}: must be finite and ≥ 0", self.scale));
+        }
+        if !self.to_world.is_finite() || (self.to_world.determinant() - 1.0).abs() > 1e-3 {
+            return Err(bad_input!("{}: the environment's frame must be a rotation", self.name));
+        }
+        if self.samples == 0 || self.samples > MAX_SAMPLES {
+            return Err(bad_input!("--env-samples {}: must be between 1 and {MAX_SAMPLES}", self.samples));
+        }
+        if let Radiance::Constant(l) = self.radiance {
+            if !(l.is_finite() && l.min_element() >= 0.0) {
+                return Err(bad_input!("{}: radiance {l} must be finite and ≥ 0", self.name));
+            }
+        }
+        Ok(())
+    }
+
+    /// Radiance arriving from world direction `d` (unit), scaled: the texel it falls in.
+    pub fn radiance_toward(&self, d: Vec3) -> Vec3 {
+        let local = self.to_world.transpose() * d;
+        match &self.radiance {
+            Radiance::Constant(l) => *l * self.scale,
+            Radiance::Image { width, height, layout, texels } => {
+                let (u, v) = direction_to_uv(*layout, local.as_dvec3());
+                let x = ((u * *width as f64) as u32).min(width - 1);
+                let y = ((v * *height as f64) as u32).min(height - 1);
+                Vec3::from(texels[(y * width + x) as usize]) * self.scale
+            }
+        }
+    }
+
+    /// The environment as directional lights: `samples` directions stratified by energy
+    /// (luminance × solid angle per texel), each carrying (radiance × solid angle) / (K · pdf)
+    /// as its irradiance at normal incidence, toward its texel's centre; samples in one texel
+    /// are one light. A map whose only bright texels have equal energy, K of them, gives exactly
+    /// those K texels as lights. A constant map is stratified over an equal-area octahedral
+    /// grid of 64² texels. `Ok(vec![])` when the map is black.
+    pub fn lights(&self) -> Result<Vec<Light>> {
+        self.validate()?;
+        const CONSTANT_GRID: u32 = 64;
+        let (width, height, layout) = match &self.radiance {
+            Radiance::Constant(_) => (CONSTANT_GRID, CONSTANT_GRID, Layout::Octahedral),
+            Radiance::Image { width, height, layout, .. } => (*width, *height, *layout),
+        };
+        let texel = |i: usize| -> DVec3 {
+            match &self.radiance {
+                Radiance::Constant(l) => l.as_dvec3(),
+                Radiance::Image { texels, .. } => Vec3::from(texels[i]).as_dvec3(),
+            }
+        };
+        let luminance = |c: DVec3| c.dot(DVec3::new(0.2126, 0.7152, 0.0722));
+        // Energy per texel, summed in f64 (millions of texels), and its running sum.
+        let n = width as usize * height as usize;
+        let mut cdf = Vec::with_capacity(n + 1);
+        cdf.push(0.0f64);
+        let mut total = 0.0f64;
+        for i in 0..n {
+            let y = (i / width as usize) as u32;
+            total += luminance(texel(i)) * solid_angle(layout, width, height, y);
+            cdf.push(total);
+        }
+        if total.is_nan() || total <= 0.0 {
+            return Ok(Vec::new());
+        }
+        let k = self.samples as usize;
+        let mut lights: Vec<(usize, DVec3)> = Vec::new();
+        let mut at = 0usize;
+        for j in 0..k {
+            let target = (j as f64 + 0.5) / k as f64 * total;
+            // The texel whose energy interval holds the stratum's centre.
+            while at + 1 < n && cdf[at + 1] <= target {
+                at += 1;
+            }
+            let l = texel(at);
+            let e = l * (total / (k as f64 * luminance(l)));
+            match lights.last_mut() {
+                Some((i, sum)) if *i == at => *sum += e,
+                _ => lights.push((at, e)),
+            }
+        }
+        let to_world: DMat3 = self.to_world.as_dmat3();
+        lights
+            .into_iter()
+            .map(|(i, e)| {
+                let (x, y) = (i as u32 % width, i as u32 / width);
+                let u = (x as f64 + 0.5) / width as f64;
+                let v = (y as f64 + 0.5) / height as f64;
+                let toward = (to_world * uv_to_direction(layout, u, v)).normalize().as_vec3();
+                let irradiance = (e * self.scale as f64).as_vec3();
+                Ok(Light::Directional { toward, irradiance })
+            })
+            .collect()
+    }
+}
+
+/// The most directions an environment may be sampled in: each is a directional light with its
+/// own shadow-map layer (the device's layer limit is checked with the frame).
+pub const MAX_SAMPLES: u32 = 4096;
+
+/// Solid angle of a texel in row `y`.
+pub fn solid_angle(layout: Layout, width: u32, height: u32, y: u32) -> f64 {
+    match layout {
+        Layout::Octahedral => 4.0 * PI / (width as f64 * height as f64),
+        Layout::LatLong => {
+            let (t0, t1) = (PI * y as f64 / height as f64, PI * (y + 1) as f64 / height as f64);
+            2.0 * PI / width as f64 * (t0.cos() - t1.cos())
+        }
+    }
+}
+
+/// The direction at (u, v) ∈ [0, 1]² of the map (v down the image).
+pub fn uv_to_direction(layout: Layout, u: f64, v: f64) -> DVec3 {
+    match layout {
+        Layout::LatLong => {
+            // Mitsuba 3 envmap: φ = 2πu − π measured from −z toward +x, θ = πv from +y.
+            let (phi, theta) = (2.0 * PI * u - PI, PI * v);
+            DVec3::new(theta.sin() * phi.sin(), theta.cos(), -theta.sin() * phi.cos())
+        }
+        Layout::Octahedral => equal_area_square_to_sphere(u, v),
+    }
+}
+
+/// The map coordinates (u, v) of a unit direction.
+pub fn direction_to_uv(layout: Layout, d: DVec3) -> (f64, f64) {
+    match layout {
+        Layout::LatLong => {
+            let phi = d.x.atan2(-d.z);
+            let u = (phi + PI) / (2.0 * PI);
+            let v = d.y.clamp(-1.0, 1.0).acos() / PI;
+            (u.rem_euclid(1.0), v)
+        }
+        Layout::Octahedral => equal_area_sphere_to_square(d),
+    }
+}
+
+/// Clarberg's equal-area map of the square onto the sphere (pbrt-v4 `EqualAreaSquareToSphere`).
+pub fn equal_area_square_to_sphere(px: f64, py: f64) -> DVec3 {
+    let (u, v) = (2.0 * px - 1.0, 2.0 * py - 1.0);
+    let (up, vp) = (u.abs(), v.abs());
+    let signed_distance = 1.0 - (up + vp);
+    let d = signed_distance.abs();
+    let r = 1.0 - d;
+    let phi = if r == 0.0 { 1.0 } else { (vp - up) / r + 1.0 } * PI / 4.0;
+    let z = (1.0 - r * r).copysign(signed_distance);
+    let cos_phi = phi.cos().copysign(u);
+    let sin_phi = phi.sin().copysign(v);
+    let s = r * (2.0 - r * r).max(0.0).sqrt();
+    DVec3::new(cos_phi * s, sin_phi * s, z)
+}
+
+/// Its inverse (pbrt-v4 `EqualAreaSphereToSquare`, with atan in f64 where pbrt uses a polynomial).
+pub fn equal_area_sphere_to_square(d: DVec3) -> (f64, f64) {
+    let (x, y, z) = (d.x.abs(), d.y.abs(), d.z.abs());
+    let r = (1.0 - z).max(0.0).sqrt();
+    let a = x.max(y);
+    let b = if a == 0.0 { 0.0 } else { x.min(y) / a };
+    let mut phi = b.atan() * 2.0 / PI;
+    if x < y {
+        phi = 1.0 - phi;
+    }
+    let mut v = phi * r;
+    let mut u = r - v;
+    if d.z < 0.0 {
+        std::mem::swap(&mut u, &mut v);
+        u = 1.0 - u;
+        v = 1.0 - v;
+    }
+    u = u.copysign(d.x);
+    v = v.copysign(d.y);
+    (0.5 * (u + 1.0), 0.5 * (v + 1.0))
+}
+
+/// A rotation about the world's up axis (+y) by `deg` degrees (`--env-rotate`).
+pub fn rotation_about_up(deg: f32) -> Mat3 {
+    Mat3::from_rotation_y(deg.to_radians())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn maps_invert_and_solid_angles_cover_the_sphere() {
+        for layout in [Layout::LatLong, Layout::Octahedral] {
+            for i in 0..40 {
+                for j in 0..40 {
+                    let (u, v) = ((i as f64 + 0.37) / 40.0, (j as f64 + 0.61) / 40.0);
+                    let d = uv_to_direction(layout, u, v);
+                    assert!((d.length() - 1.0).abs() < 1e-12, "{layout:?} {u} {v}");
+                    let (u2, v2) = direction_to_uv(layout, d);
+                    assert!((u - u2).abs() < 1e-9 && (v - v2).abs() < 1e-9, "{layout:?}: {u},{v} -> {u2},{v2}");
+                }
+            }
+            let (w, h) = if layout == Layout::LatLong { (64, 32) } else { (32, 32) };
+            let total: f64 = (0..h).map(|y| w as f64 * solid_angle(layout, w, h, y)).sum();
+            assert!((total - 4.0 * PI).abs() < 1e-9, "{layout:?}: {total}");
+        }
+        // Mitsuba's latitude-longitude convention: the centre column looks down −z... +y at the top.
+        assert!((uv_to_direction(Layout::LatLong, 0.5, 0.5) - DVec3::NEG_Z).length() < 1e-12);
+        assert!((uv_to_direction(Layout::LatLong, 0.75, 0.5) - DVec3::X).length() < 1e-12);
+        assert!((uv_to_direction(Layout::LatLong, 0.3, 0.0) - DVec3::Y).length() < 1e-12);
+    }
+
+    /// A constant map's samples carry its whole irradiance: Σ E_k = π L · 4 (the sphere's
+    /// ∫ L dω = 4π L, each sample's E at normal incidence being its share of it).
+    #[test]
+    fn samples_carry_the_whole_map() {
+        for k in [1, 16, 64, 256] {
+            let env = Environment {
+                name: "test".into(),
+                radiance: Radiance::Constant(Vec3::new(1.0, 0.5, 0.25)),
+                scale: 2.0,
+                to_world: Mat3::IDENTITY,
+                samples: k,
+            };
+            let lights = env.lights().unwrap();
+            assert_eq!(lights.len(), k as usize);
+            let sum: Vec3 = lights
+                .iter()
+                .map(|l| if let Light::Directional { irradiance, .. } = l { *irradiance } else { Vec3::ZERO })
+                .sum();
+            let expected = Vec3::new(1.0, 0.5, 0.25) * 2.0 * 4.0 * std::f32::consts::PI;
+            assert!((sum - expected).abs().max_element() < 1e-4 * expected.max_element(), "{k}: {sum} vs {expected}");
+        }
+    }
+}
