@@ -164,11 +164,8 @@ vec3 specular(vec3 xo, vec3 no, vec3 wo) {
 void main() {
     ivec2 pixel = ivec2(gl_FragCoord.xy);
     vec4 surface = imageLoad(surface_position, pixel);
-    if (surface.w == 0.0) {
-        // No surface: the background stays clear (and adds nothing to brute-force sums).
-        radiance = vec4(0.0);
-        return;
-    }
+    // No surface: the background pass drew it.
+    if (surface.w == 0.0) discard;
     // Another object's pixel: its own draw shades it.
     if (surface.w != float(pc.point_range.z + 1u)) discard;
     vec3 xo = surface.xyz;

@@ -333,6 +333,24 @@ pub struct RenderArgs {
     /// cone of ANGLE degrees from its axis, in (0, 180]; its intensity falls to 0 over the cone's
     /// outer DELTA degrees, in [0, ANGLE], default 5 (pbrt-v4's spot: a smoothstep in cos θ); I =
     /// radiant intensity along the axis).
+    /// An environment light: an EXR, Radiance HDR or PNG map (2:1 latitude-longitude, +y up, as
+    /// Mitsuba 3's envmap; or square equal-area octahedral, z up, as pbrt-v4's infinite light) or
+    /// `const:L` (one value or R,G,B) or `sky[:ELEVATION:AZIMUTH]` (a synthetic sky with a sun
+    /// at ELEVATION degrees above the horizon, AZIMUTH from −z toward +x; default 30:30). It is sampled in --env-samples directions stratified by
+    /// its energy, each a shadowed directional light, and shows behind the objects. It replaces
+    /// the default light; --light adds lights to it.
+    #[arg(long, value_name = "FILE | const:L | sky[:E:A]")]
+    pub env: Option<String>,
+    /// Multiplies the environment's radiance.
+    #[arg(long, allow_hyphen_values = true, default_value_t = 1.0, value_parser = finite_f32)]
+    pub env_scale: f32,
+    /// Turns the environment about the up axis (+y), in degrees.
+    #[arg(long, allow_hyphen_values = true, default_value_t = 0.0, value_parser = finite_f32)]
+    pub env_rotate: f32,
+    /// Directions the environment is sampled in (each a directional light with its own shadow
+    /// map). Measured against 1024 directions (tests/environment.rs): see the README.
+    #[arg(long, default_value_t = crate::environment::DEFAULT_SAMPLES, value_parser = clap::value_parser!(u32).range(1..=crate::environment::MAX_SAMPLES as i64))]
+    pub env_samples: u32,
     #[arg(long = "light", value_parser = light_spec, value_name = "dir:X,Y,Z[:I] | point:X,Y,Z[:I] | spot:X,Y,Z:TX,TY,TZ:ANGLE[:DELTA[:I]]")]
     pub lights: Vec<Light>,
     /// Sample points on the surface (default: from the material's diffusion length and the mesh's area).
@@ -480,7 +498,7 @@ fn vec3(s: &str) -> std::result::Result<Vec3, String> {
     }
 }
 
-fn rgb(s: &str) -> std::result::Result<Vec3, String> {
+pub(crate) fn rgb(s: &str) -> std::result::Result<Vec3, String> {
     let v = match numbers(s)?.as_slice() {
         [i] => Vec3::splat(*i),
         [r, g, b] => Vec3::new(*r, *g, *b),

@@ -28,10 +28,24 @@ pub enum Layout {
 }
 
 /// Radiance per direction.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 pub enum Radiance {
     Constant(Vec3),
     Image { width: u32, height: u32, layout: Layout, texels: Arc<Vec<[f32; 3]>> },
+}
+
+impl PartialEq for Radiance {
+    /// The same map: the same texels (the same shared copy compares at once).
+    fn eq(&self, other: &Radiance) -> bool {
+        match (self, other) {
+            (Radiance::Constant(a), Radiance::Constant(b)) => a == b,
+            (
+                Radiance::Image { width, height, layout, texels },
+                Radiance::Image { width: w2, height: h2, layout: l2, texels: t2 },
+            ) => (width, height, layout) == (w2, h2, l2) && (Arc::ptr_eq(texels, t2) || texels == t2),
+            _ => false,
+        }
+    }
 }
 
 /// The default number of directions an environment is sampled in (`--env-samples`).
@@ -197,6 +211,33 @@ impl Environment {
             })
             .collect()
     }
+}
+
+/// A synthetic sky with a sun, as a latitude-longitude map of 512×256 texels: blue toward the
+/// zenith, bright at the horizon, a dim ground below it, and a sun 2.5° in radius at `elevation`
+/// degrees above the horizon and `azimuth` degrees from −z toward +x (0: behind the object as
+/// the default camera sees it). Its sun brings about twice the sky's irradiance.
+pub fn sky(elevation: f32, azimuth: f32) -> Radiance {
+    let (width, height) = (512u32, 256u32);
+    let (e, a) = (elevation.to_radians() as f64, azimuth.to_radians() as f64);
+    let sun = DVec3::new(e.cos() * a.sin(), e.sin(), -e.cos() * a.cos());
+    let cos_sun = 2.5f64.to_radians().cos();
+    let mut texels = Vec::with_capacity((width * height) as usize);
+    for y in 0..height {
+        for x in 0..width {
+            let d = uv_to_direction(Layout::LatLong, (x as f64 + 0.5) / width as f64, (y as f64 + 0.5) / height as f64);
+            let l = if d.dot(sun) >= cos_sun {
+                DVec3::new(500.0, 450.0, 380.0)
+            } else if d.y >= 0.0 {
+                let t = d.y.powf(0.5);
+                DVec3::new(0.45, 0.45, 0.5) * (1.0 - t) + DVec3::new(0.1, 0.18, 0.4) * t
+            } else {
+                DVec3::new(0.06, 0.05, 0.04)
+            };
+            texels.push(l.as_vec3().to_array());
+        }
+    }
+    Radiance::Image { width, height, layout: Layout::LatLong, texels: Arc::new(texels) }
 }
 
 /// The most directions an environment may be sampled in: each is a directional light with its

@@ -13,6 +13,7 @@ use crate::gpu::{DebugConstants, FrameParams, ShadeConstants, WorkCounters};
 use crate::gpu_world::{GpuObject, GpuWorld};
 use crate::hierarchy::Hierarchy;
 use crate::output::{self, Exposure, HdrImage};
+use crate::passes::background::BackgroundPass;
 use crate::passes::debug_view::{self, DebugViewPass};
 use crate::passes::diffuse::DiffusePass;
 use crate::passes::irradiance::IrradiancePass;
@@ -371,6 +372,7 @@ struct Passes {
     shade: ShadePass,
     debug_view: DebugViewPass,
     diffuse: DiffusePass,
+    background: BackgroundPass,
     tonemap: TonemapPass,
 }
 
@@ -382,6 +384,7 @@ impl Passes {
             shade: ShadePass::new(ctx)?,
             debug_view: DebugViewPass::new(ctx)?,
             diffuse: DiffusePass::new(ctx)?,
+            background: BackgroundPass::new(ctx)?,
             tonemap: TonemapPass::new(ctx)?,
         })
     }
@@ -479,6 +482,7 @@ impl Renderer {
         desc.validate()?;
         world.validate()?;
         self.world.sync(&self.ctx, world, desc)?;
+        self.passes.background.sync(&self.ctx, desc.environment.as_ref())?;
         self.fit_targets(desc.width, desc.height)?;
         // A work record per object.
         let work_bytes = (self.world.objects.len() * std::mem::size_of::<WorkCounters>()) as u64;
@@ -547,6 +551,12 @@ impl Renderer {
             // The depth pre-pass and the G-buffer (world position with the object, normal, and
             // the reflectance of opaque objects).
             rec.scope("surface", |rec| self.passes.shade.record_surface(rec, &inputs, &opaque, &constants))?;
+            // What no surface covers: the environment, or black.
+            let aspect = desc.width as f32 / desc.height as f32;
+            let t = &self.targets;
+            rec.scope("background", |rec| {
+                self.passes.background.record(rec, &t.color, &t.position, &desc.camera, aspect)
+            })?;
             if let Some(shadows) = w.opaque_shadows.as_ref().filter(|_| shading) {
                 // The opaque objects' reflection of the lights.
                 let t = &self.targets;

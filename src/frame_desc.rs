@@ -69,6 +69,8 @@ pub struct FrameDesc {
     /// At least 1; as many as the device's shadow-map layers allow (checked with the frame's
     /// other sizes in [`crate::budget::check_frame`]).
     pub lights: Vec<Light>,
+    /// The environment shown behind the objects (its samples are among `lights`).
+    pub environment: Option<std::sync::Arc<crate::environment::Environment>>,
     pub width: u32,
     pub height: u32,
     pub integration: Integration,
@@ -93,6 +95,7 @@ impl FrameDesc {
         FrameDesc {
             camera,
             lights,
+            environment: None,
             width: 512,
             height: 512,
             integration: Integration::default(),
@@ -121,6 +124,9 @@ impl FrameDesc {
             return Err(bad_input!("--shadow-resolution {}: must be between {lo} and {hi}", self.shadow_resolution));
         }
         check_camera(&self.camera)?;
+        if let Some(env) = &self.environment {
+            env.validate()?;
+        }
         check_lights(&self.lights)
     }
 

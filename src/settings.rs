@@ -195,9 +195,24 @@ impl RenderSettings {
     /// rest of the frame and the world.
     pub fn from_args(args: &RenderArgs) -> Result<RenderSettings> {
         check_roughness(args.roughness, "--roughness")?;
-        let scene = SceneSettings::from_args(args).build()?;
+        let mut scene = SceneSettings::from_args(args).build()?;
+        let environment = match &args.env {
+            Some(spec) => {
+                let env = environment_from_args(spec, args)?;
+                if args.lights.is_empty() {
+                    scene.lights.clear(); // the environment replaces the default light
+                }
+                scene.lights.extend(env.lights()?);
+                if scene.lights.is_empty() {
+                    return Err(bad_input!("--env {spec}: the map is black everywhere: nothing lights the scene"));
+                }
+                Some(std::sync::Arc::new(env))
+            }
+            None => None,
+        };
         let material = args.material.material()?;
         let mut s = RenderSettings::new(scene, material);
+        s.desc.environment = environment;
         s.world.objects[0].samples = args.samples;
         let d = &mut s.desc;
         d.integration = Integration {
@@ -220,4 +235,38 @@ impl RenderSettings {
         s.world.validate()?;
         Ok(s)
     }
+}
+
+/// `--env FILE | const:L` with its scale, rotation and sample count.
+fn environment_from_args(spec: &str, args: &RenderArgs) -> Result<crate::environment::Environment> {
+    use crate::environment::{rotation_about_up, Environment, Radiance};
+    let sky = |rest: &str| -> Result<Radiance> {
+        let v: Vec<f32> = rest
+            .split(':')
+            .filter(|p| !p.is_empty())
+            .map(crate::cli::finite_f32)
+            .collect::<std::result::Result<_, _>>()
+            .map_err(|e| bad_input!("--env {spec}: {e}"))?;
+        match v.as_slice() {
+            [] => Ok(crate::environment::sky(30.0, 30.0)),
+            [e, a] if (-90.0..=90.0).contains(e) => Ok(crate::environment::sky(*e, *a)),
+            _ => Err(bad_input!("--env {spec}: expected sky[:ELEVATION:AZIMUTH] (degrees, elevation within ±90)")),
+        }
+    };
+    let radiance = if let Some(l) = spec.strip_prefix("const:") {
+        Radiance::Constant(crate::cli::rgb(l).map_err(|e| bad_input!("--env {spec}: {e}"))?)
+    } else if spec == "sky" || spec.starts_with("sky:") {
+        sky(&spec[3..])?
+    } else {
+        Environment::load(std::path::Path::new(spec), &format!("--env {spec}"))?
+    };
+    let env = Environment {
+        name: format!("--env {spec}"),
+        radiance,
+        scale: args.env_scale,
+        to_world: rotation_about_up(args.env_rotate),
+        samples: args.env_samples,
+    };
+    env.validate()?;
+    Ok(env)
 }

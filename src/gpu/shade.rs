@@ -65,3 +65,20 @@ pub struct DiffuseConstants {
     pub first_opaque: u32,
     pub pad: [u32; 3],
 }
+
+/// Mirrors `BackgroundConstants` in shaders/include/background_constants.glsl: the background pass.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct BackgroundConstants {
+    /// Pixel → direction in the map's frame, as columns (w unused).
+    pub ray_x: glam::Vec4,
+    pub ray_y: glam::Vec4,
+    pub ray_z: glam::Vec4,
+    /// rgb: a constant map's radiance; w: the scale.
+    pub constant: glam::Vec4,
+    /// 0 none, 1 constant, 2 latitude-longitude, 3 equal-area octahedral.
+    pub kind: u32,
+    pub width: u32,
+    pub height: u32,
+    pub pad: u32,
+}

@@ -1,5 +1,6 @@
 //! GPU passes: each is one shader (or a few stages of one) plus one file here.
 
+pub mod background;
 pub mod bssrdf_eval;
 pub mod debug_view;
 pub mod diffuse;
