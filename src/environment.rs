@@ -149,12 +149,15 @@ impl Environment {
         }
     }
 
-    /// The environment as directional lights: `samples` directions stratified by energy
-    /// (luminance × solid angle per texel), each carrying (radiance × solid angle) / (K · pdf)
-    /// as its irradiance at normal incidence, toward its texel's centre; samples in one texel
-    /// are one light. A map whose only bright texels have equal energy, K of them, gives exactly
-    /// those K texels as lights. A constant map is stratified over an equal-area octahedral
-    /// grid of 64² texels. `Ok(vec![])` when the map is black.
+    /// The environment as directional lights: the map cut into `samples` regions of equal
+    /// energy (luminance × solid angle), in the order of a Morton curve over the texels so that
+    /// each region is compact on the sphere; each region is one light toward its energy-weighted
+    /// mean direction, carrying the region's ∫ L dω (texels split between regions by the
+    /// fraction of their energy in each) as its irradiance at normal incidence. The lights' sum
+    /// is the whole map's; a map whose only bright texels have equal energy, K of them, gives
+    /// exactly those K texels as lights. A constant map is cut from an equal-area octahedral grid
+    /// of 64² texels. Regions within one texel (a bright sun) are one light. `Ok(vec![])` when
+    /// the map is black.
     pub fn lights(&self) -> Result<Vec<Light>> {
         self.validate()?;
         const CONSTANT_GRID: u32 = 64;
@@ -169,48 +172,68 @@ impl Environment {
             }
         };
         let luminance = |c: DVec3| c.dot(DVec3::new(0.2126, 0.7152, 0.0722));
-        // Energy per texel, summed in f64 (millions of texels), and its running sum.
         let n = width as usize * height as usize;
-        let mut cdf = Vec::with_capacity(n + 1);
-        cdf.push(0.0f64);
-        let mut total = 0.0f64;
-        for i in 0..n {
-            let y = (i / width as usize) as u32;
-            total += luminance(texel(i)) * solid_angle(layout, width, height, y);
-            cdf.push(total);
-        }
+        let mut order: Vec<u32> = (0..n as u32).collect();
+        order.sort_by_key(|&i| morton(i % width, i / width));
+        // Energy per texel, in f64 (millions of texels).
+        let energy: Vec<f64> = order
+            .iter()
+            .map(|&i| luminance(texel(i as usize)) * solid_angle(layout, width, height, i / width))
+            .collect();
+        let total: f64 = energy.iter().sum();
         if total.is_nan() || total <= 0.0 {
             return Ok(Vec::new());
         }
+        let to_world: DMat3 = self.to_world.as_dmat3();
         let k = self.samples as usize;
-        let mut lights: Vec<(usize, DVec3)> = Vec::new();
-        let mut at = 0usize;
+        let mut lights: Vec<Light> = Vec::with_capacity(k);
+        let (mut at, mut start) = (0usize, 0.0f64); // the texel and where its energy starts
         for j in 0..k {
-            let target = (j as f64 + 0.5) / k as f64 * total;
-            // The texel whose energy interval holds the stratum's centre.
-            while at + 1 < n && cdf[at + 1] <= target {
+            let (b0, b1) = (total * j as f64 / k as f64, total * (j + 1) as f64 / k as f64);
+            let (mut direction, mut rgb) = (DVec3::ZERO, DVec3::ZERO);
+            while at < n {
+                let end = start + energy[at];
+                let overlap = end.min(b1) - start.max(b0);
+                if overlap > 0.0 {
+                    let i = order[at];
+                    let (x, y) = (i % width, i / width);
+                    let d = uv_to_direction(layout, (x as f64 + 0.5) / width as f64, (y as f64 + 0.5) / height as f64);
+                    let fraction = overlap / energy[at];
+                    direction += d * overlap;
+                    rgb += texel(i as usize) * solid_angle(layout, width, height, y) * fraction;
+                }
+                if end > b1 || (at + 1 == n) {
+                    break;
+                }
+                start = end;
                 at += 1;
             }
-            let l = texel(at);
-            let e = l * (total / (k as f64 * luminance(l)));
+            let toward = (to_world * direction).normalize_or_zero().as_vec3();
+            let irradiance = (rgb * self.scale as f64).as_vec3();
+            if toward == Vec3::ZERO {
+                continue;
+            }
             match lights.last_mut() {
-                Some((i, sum)) if *i == at => *sum += e,
-                _ => lights.push((at, e)),
+                Some(Light::Directional { toward: t, irradiance: e }) if *t == toward => *e += irradiance,
+                _ => lights.push(Light::Directional { toward, irradiance }),
             }
         }
-        let to_world: DMat3 = self.to_world.as_dmat3();
-        lights
-            .into_iter()
-            .map(|(i, e)| {
-                let (x, y) = (i as u32 % width, i as u32 / width);
-                let u = (x as f64 + 0.5) / width as f64;
-                let v = (y as f64 + 0.5) / height as f64;
-                let toward = (to_world * uv_to_direction(layout, u, v)).normalize().as_vec3();
-                let irradiance = (e * self.scale as f64).as_vec3();
-                Ok(Light::Directional { toward, irradiance })
-            })
-            .collect()
+        Ok(lights)
     }
+}
+
+/// Interleaves the bits of x and y (a Morton key).
+fn morton(x: u32, y: u32) -> u64 {
+    let spread = |v: u32| {
+        let mut v = v as u64;
+        v = (v | (v << 16)) & 0x0000_ffff_0000_ffff;
+        v = (v | (v << 8)) & 0x00ff_00ff_00ff_00ff;
+        v = (v | (v << 4)) & 0x0f0f_0f0f_0f0f_0f0f;
+        v = (v | (v << 2)) & 0x3333_3333_3333_3333;
+        v = (v | (v << 1)) & 0x5555_5555_5555_5555;
+        v
+    };
+    spread(x) | (spread(y) << 1)
 }
 
 /// A synthetic sky with a sun, as a latitude-longitude map of 512×256 texels: blue toward the

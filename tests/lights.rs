@@ -1,0 +1,109 @@
+//! Many lights at nearly the cost of one: the tree carries every light in one merged record per
+//! point and node (PointFlux, NodeFlux), measured here against brute force, which sums every
+//! (point, light) pair exactly.
+
+mod common;
+
+use common::render_hdr;
+use glam::Vec3;
+use translucent::materials::Material;
+use translucent::physics::Model;
+use translucent::scene::Light;
+use translucent::settings::{RenderSettings, SceneSettings};
+
+/// Relative RMSE over the pixels `reference` covers.
+fn relative_rmse(a: &[[f32; 4]], reference: &[[f32; 4]]) -> f64 {
+    let (mut err, mut norm) = (0.0f64, 0.0f64);
+    for (p, q) in a.iter().zip(reference).filter(|(_, q)| q[3] > 0.0) {
+        for c in 0..3 {
+            err += (p[c] as f64 - q[c] as f64).powi(2);
+            norm += (q[c] as f64).powi(2);
+        }
+    }
+    (err / norm).sqrt()
+}
+
+/// `k` directional lights within `cone_deg` of `axis`, of different strengths and colours
+/// (a small deterministic generator: the same lights on every run), total irradiance about 1.
+pub fn lights_about(axis: Vec3, k: usize, cone_deg: f32, seed: u64) -> Vec<Light> {
+    let mut state = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+    let mut next = || {
+        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((state >> 40) as f32) / (1u64 << 24) as f32
+    };
+    let axis = axis.normalize();
+    let (u, v) = axis.any_orthonormal_pair();
+    (0..k)
+        .map(|_| {
+            let c = 1.0 - next() * (1.0 - cone_deg.to_radians().cos());
+            let (s, phi) = ((1.0 - c * c).max(0.0).sqrt(), next() * std::f32::consts::TAU);
+            let toward = (axis * c + (u * phi.cos() + v * phi.sin()) * s).normalize();
+            let colour = Vec3::new(0.6 + 0.8 * next(), 0.6 + 0.8 * next(), 0.6 + 0.8 * next());
+            Light::Directional { toward, irradiance: colour * (2.0 / k as f32) }
+        })
+        .collect()
+}
+
+fn settings(mesh: &str, lights: Vec<Light>, model: Model, brute_force: bool) -> RenderSettings {
+    let scene = SceneSettings { mesh: Some(mesh.into()), lights, ..Default::default() };
+    let mut s = RenderSettings::new(scene.build().expect("scene"), Material::find("skin1").unwrap());
+    (s.desc.width, s.desc.height, s.world.objects[0].samples) = (32, 32, Some(3000));
+    s.desc.specular = false;
+    (s.desc.integration.model, s.desc.integration.brute_force) = (model, brute_force);
+    s
+}
+
+/// Merged records against exact per-light brute force, for the directional dipole on a
+/// front-lit, a back-lit and a grazing-lit sphere with 2, 8 and 64 lights within 30° of the main
+/// direction (the camera looks along −z: front is +z, back −z, grazing +x). Two errors are
+/// measured apart: the merging's own (every point evaluated singly, ε = 0, against brute
+/// force) and the tree's at the default ε, which adds the tree's own error (that of one light
+/// alone, measured beside it). The goal is 0.5%; the merged records do not reach it
+/// everywhere on Skin1 at these 3000 points (measured, lavapipe: merging alone 0.34% with 2
+/// front lights, 0.91% with 8; the near field's real-source distance dr is not affine in the
+/// refracted direction). These bounds guard what was measured; the README gives the table.
+#[test]
+fn merged_lights_match_exact_brute_force() {
+    for (case, axis) in [
+        ("front", Vec3::new(0.3, 0.5, 1.0)),
+        ("back", Vec3::new(0.0, 0.2, -1.0)),
+        ("grazing", Vec3::new(1.0, 0.0, 0.05)),
+    ] {
+        let one = vec![Light::Directional { toward: axis.normalize(), irradiance: Vec3::splat(2.0) }];
+        let tree_one = render_hdr(&settings("sphere", one.clone(), Model::Directional, false));
+        let exact_one = render_hdr(&settings("sphere", one, Model::Directional, true));
+        let tree_error = relative_rmse(&tree_one.pixels, &exact_one.pixels);
+        for k in [2, 8, 64] {
+            let lights = lights_about(axis, k, 30.0, k as u64);
+            let exact = render_hdr(&settings("sphere", lights.clone(), Model::Directional, true));
+            let tree = render_hdr(&settings("sphere", lights.clone(), Model::Directional, false));
+            let mut points = settings("sphere", lights, Model::Directional, false);
+            points.desc.integration.epsilon = 0.0;
+            let points = render_hdr(&points);
+            let merging = relative_rmse(&points.pixels, &exact.pixels);
+            let error = relative_rmse(&tree.pixels, &exact.pixels);
+            println!(
+                "{case}, {k} lights against exact brute force: merging alone {:.3}%, the tree {:.3}% (one light's tree {:.3}%)",
+                merging * 100.0,
+                error * 100.0,
+                tree_error * 100.0
+            );
+            assert!(merging <= 1.5e-2, "{case}, {k} lights: merging {merging}");
+            assert!(error <= tree_error + 1.5e-2, "{case}, {k} lights: tree {error}, one light's {tree_error}");
+        }
+    }
+}
+
+/// The classical dipole does not depend on the light's direction: merging is exact, so with
+/// every point evaluated on its own (ε = 0) the tree equals exact brute force to rounding.
+#[test]
+fn classical_dipole_merges_exactly() {
+    let lights = lights_about(Vec3::new(0.2, 1.0, 0.3), 16, 80.0, 7);
+    let mut tree = settings("sphere", lights.clone(), Model::Dipole, false);
+    tree.desc.integration.epsilon = 0.0;
+    let tree = render_hdr(&tree);
+    let exact = render_hdr(&settings("sphere", lights, Model::Dipole, true));
+    let error = relative_rmse(&tree.pixels, &exact.pixels);
+    println!("classical dipole, 16 lights, ε = 0: relative RMSE {error:.2e}");
+    assert!(error <= 1e-5, "{error}");
+}
