@@ -80,10 +80,10 @@ impl BeamMedium {
 
     /// Below this distance (mm) the profile is held at its value here: single scattering grows as
     /// 1/r and multiple scattering as ln(1/r) towards r = 0 (integrable over the plane, but not a
-    /// finite value a table or a CSV row can hold). A thousandth of a mean free path: the disc
-    /// inside holds about 1e-3 of single scattering's plane integral.
+    /// finite value a table or a CSV row can hold). 1e-5 of a mean free path: held there, the disc
+    /// inside loses about 2e-5 of single scattering's plane integral.
     pub fn r_floor(&self) -> f64 {
-        1e-3 / self.sigma_t.max(f64::MIN_POSITIVE)
+        1e-5 / self.sigma_t.max(f64::MIN_POSITIVE)
     }
 }
 
@@ -201,6 +201,23 @@ pub fn single_scattering_total(albedo: f64, eta: f64) -> f64 {
     // The inside's critical cosine √(1 − 1/η²): Ft is 0 below it.
     let mu_c = (1.0 - 1.0 / (eta * eta)).max(0.0).sqrt();
     0.5 * albedo * above_critical(mu_c, |mu| fresnel::transmittance(1.0 / eta, mu) * mu / (1.0 + mu))
+}
+
+/// The plane integral ∫M dA of the beam's dipoles with one ρ' and no κ, in closed form:
+/// ρ' σ't/(σ't + σtr) · [Cφ(1 − e^{−2σtr zb})/(2Dσtr) + (CE/2)(1 + e^{−2σtr zb})] (each dipole's
+/// ∫M dA as in halfspace.rs `point_source_plane`, averaged over the beam's e^{−σ't z}). Extended-
+/// source diffusion of *every* order, single scattering included: the diagnostic that shows what
+/// beam diffusion's ρ'²κ + exact single scattering counts twice (tests/beam_diffusion.rs).
+pub fn extended_source_total(b: &BeamMedium) -> f64 {
+    if !b.transports() {
+        return 0.0;
+    }
+    let s = b.sigma_tr;
+    let ev = (-2.0 * s * b.zb).exp();
+    // (1 − e^{−2σtr zb})/σtr → 2zb as σtr → 0.
+    let phi_part = if s > 0.0 { -(-2.0 * s * b.zb).exp_m1() / s } else { 2.0 * b.zb };
+    b.albedo_reduced * b.sigma_t_reduced / (b.sigma_t_reduced + s)
+        * (b.c_phi * phi_part / (2.0 * b.d) + b.c_e / 2.0 * (1.0 + ev))
 }
 
 /// ∫Sd dA over the disc r < `radius`: what the first entry of a table must hold for the first
