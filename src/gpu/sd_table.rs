@@ -96,6 +96,11 @@ impl SdTable {
         texels
     }
 
+    /// Entry `i`'s value in channel 0 (1/mm²).
+    pub fn lookup_entry(&self, i: usize) -> f64 {
+        self.scale[0] as f64 * half_value(self.values[i][0])
+    }
+
     /// Sd per channel at distance `r` (mm), as the shade pass reads it: `dipole_sd_table` in
     /// shaders/include/bssrdf.glsl.
     pub fn lookup(&self, r: f64) -> [f64; 3] {
