@@ -6,6 +6,7 @@
 //! `nice -n 19 cargo run --release --example albedo_plot` (about a minute).
 
 use plotters::style::RGBColor;
+use translucent::physics::beam_diffusion::{self, BeamMedium};
 use translucent::physics::{halfspace, Diffusion, Medium};
 use translucent::plot::{write_albedo_plot, AlbedoSeries};
 
@@ -27,21 +28,29 @@ fn main() {
             (a, halfspace::exitance_total(&c, halfspace::ray_source_plane(&c, 1.0), 1.0))
         })
         .collect();
+    // Photon beam diffusion: its f64 profile's plane integral, multiple and single scattering.
+    let pbd_total = |a: f64| {
+        let b = BeamMedium::new(&Medium { sigma_a: 1.0 - a, sigma_s: a, g: 0.0, eta });
+        let plane = halfspace::plane_integral(|x| beam_diffusion::sd(&b, x.length()), 1e-7, 60.0 / b.sigma_tr, 1);
+        halfspace::model_total(plane, eta, 1.0)
+    };
+    let pbd: Vec<(f64, f64)> = curve.iter().map(|&a| (a, pbd_total(a))).collect();
     let albedos = [0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.85, 0.9, 0.95, 0.97, 0.98, 0.99, 0.995, 0.999];
     let traced: Vec<(f64, f64)> = albedos
         .iter()
         .enumerate()
         .map(|(i, &a)| (a, halfspace::rte_reflectance(a, eta, 1.0, 200_000, 100 + i as u64).total))
         .collect();
-    println!("albedo,path_traced,classical,directional,directional_times_alpha,ray_source_integrated");
+    println!("albedo,path_traced,classical,directional,directional_times_alpha,ray_source_integrated,beam_diffusion");
     for &(a, pt) in &traced {
         let c = constants(a);
         let dir = halfspace::model_total(halfspace::dirpole_plane(&c, 1.0), eta, 1.0);
         println!(
-            "{a},{pt:.4},{:.4},{dir:.4},{:.4},{:.4}",
+            "{a},{pt:.4},{:.4},{dir:.4},{:.4},{:.4},{:.4}",
             halfspace::dipole_total(&c, 1.0),
             a * dir,
-            halfspace::exitance_total(&c, halfspace::ray_source_plane(&c, 1.0), 1.0)
+            halfspace::exitance_total(&c, halfspace::ray_source_plane(&c, 1.0), 1.0),
+            pbd_total(a)
         );
     }
     let series = [
@@ -68,6 +77,12 @@ fn main() {
             colour: RGBColor(40, 60, 210),
             points_only: false,
             points: classical,
+        },
+        AlbedoSeries {
+            label: "photon beam diffusion (multiple + single scattering)".into(),
+            colour: RGBColor(30, 150, 70),
+            points_only: false,
+            points: pbd,
         },
         AlbedoSeries {
             label: "path tracer (exact RTE, half-space Monte Carlo)".into(),

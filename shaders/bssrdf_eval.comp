@@ -13,14 +13,18 @@ struct BssrdfQuery {
     vec4 wi;
     vec4 xo;
     vec4 no;
+    uvec4 table; // x: the row's Sd table in `tables` (photon beam diffusion; channel 0 holds it)
 };
 
 layout(std430, binding = 0) readonly buffer Queries { BssrdfQuery queries[]; };
 layout(std430, binding = 1) writeonly buffer Results { float sd[]; };
+// Photon beam diffusion's Sd tables (gpu::SdTable), one per distinct medium, end to end; a
+// placeholder for the other models.
+layout(binding = 2) uniform usamplerBuffer tables;
 
 layout(push_constant) uniform EvalConstants {
     uint count;
-    uint model; // 0 directional dipole, 1 classical dipole
+    uint model; // 0 directional dipole, 1 classical dipole, 2 photon beam diffusion
 } pc;
 
 void main() {
@@ -30,6 +34,10 @@ void main() {
     float value;
     if (pc.model == MODEL_DIRECTIONAL) {
         value = dirpole_sd(q.channel, q.xi.xyz, q.ni.xyz, q.wi.xyz, q.xo.xyz, q.no.xyz);
+    } else if (pc.model == MODEL_PBD) {
+        // As the shade pass reads it.
+        int base = int(q.table.x * DIPOLE_TABLE_SIZE);
+        value = sd_table_at(tables, base, sd_table_header_at(tables, base), length(q.xo.xyz - q.xi.xyz)).x;
     } else {
         value = dipole_sd(q.channel, length(q.xo.xyz - q.xi.xyz));
     }

@@ -23,7 +23,7 @@
 // The model, fixed per pipeline: llvmpipe runs both sides of a branch for every SIMD group, so a
 // model chosen at run time would cost both models' arithmetic (measured: the classical dipole
 // took 2.4x longer beside the directional one's dead code).
-layout(constant_id = 0) const uint MODEL = 0u; // 0 directional dipole, 1 classical dipole
+layout(constant_id = 0) const uint MODEL = 0u; // 0 directional dipole, 1 classical dipole, 2 beam diffusion (1, 2: table)
 
 layout(location = 0) out vec4 radiance;
 
@@ -47,7 +47,7 @@ layout(binding = 9, rgba32f) uniform readonly image2D surface_normal;
 // The tile-cut pass's lists (see tile_lists.glsl): a header texel per tile, entries 4 per texel.
 layout(binding = 10) uniform usamplerBuffer tile_headers;
 layout(binding = 11) uniform usamplerBuffer tile_entries;
-// The classical dipole's Sd per channel, tabulated (bssrdf.glsl).
+// The model's Sd per channel, tabulated (bssrdf.glsl): the classical dipole's or beam diffusion's.
 layout(binding = 12) uniform usamplerBuffer dipole_table;
 layout(std140, binding = 13) uniform Frame { FrameParams frame_params; };
 // PointFlux (sorted) as texels.

@@ -174,10 +174,11 @@ pub enum ShowArg {
     Tree,
 }
 
-/// `--model NAME`: a model registered in src/models.rs.
+/// `--model NAME`: a model registered in src/models.rs, by its name or an alias.
 fn model_arg() -> impl clap::builder::TypedValueParser<Value = Model> {
-    use clap::builder::TypedValueParser;
-    let names: Vec<&'static str> = crate::models::MODELS.iter().map(|e| e.name).collect();
+    use clap::builder::{PossibleValue, TypedValueParser};
+    let names: Vec<PossibleValue> =
+        crate::models::MODELS.iter().map(|e| PossibleValue::new(e.name).aliases(e.aliases.iter().copied())).collect();
     clap::builder::PossibleValuesParser::new(names).map(|name| Model::from_name(&name).unwrap_or_default())
 }
 

@@ -61,7 +61,7 @@ macro_rules! shade_inputs {
             node_flux: &o.hierarchy.node_flux,
             tile_headers: &lists.headers,
             tile_entries: &lists.entries,
-            dipole_table: &o.dipole_table,
+            sd_table: &o.sd_table,
         }
     }};
 }

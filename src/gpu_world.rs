@@ -13,7 +13,8 @@ use crate::gpu::{DiffuseSurfaceConstants, GpuChannel, ObjectParams, SdTable};
 use crate::hierarchy::{self, Hierarchy, HierarchyOptions};
 use crate::materials::Material;
 use crate::mesh::Mesh;
-use crate::physics::Diffusion;
+use crate::physics::beam_diffusion::BeamMedium;
+use crate::physics::{Diffusion, Model};
 use crate::scene::Light;
 use crate::shadows::Shadows;
 use crate::vk::{
@@ -31,8 +32,9 @@ pub struct GpuObject {
     pub bounds: (Vec3, Vec3),
     /// The material's constants and the tree's size (`ObjectParams`, a uniform buffer).
     pub params: Buffer,
-    /// The classical dipole's Sd table (texels) for the material.
-    pub dipole_table: Buffer,
+    /// The Sd table (texels) of the material for the frame's model: photon beam diffusion's for
+    /// `pbd`, else the classical dipole's (the directional dipole reads none).
+    pub sd_table: Buffer,
     /// What the buffers above were made from.
     made_from: MadeFrom,
 }
@@ -42,9 +44,27 @@ struct MadeFrom {
     mesh: Mesh,
     material: Material,
     diffusion: Diffusion,
+    /// Which profile the Sd table holds.
+    table: TableProfile,
     mm_per_unit: f32,
     /// The sample count asked for (`None`: the default), and the count it resolved to.
     samples: Option<u32>,
+}
+
+/// The radial profile an object's Sd table holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum TableProfile {
+    Dipole,
+    BeamDiffusion,
+}
+
+impl TableProfile {
+    fn of(model: Model) -> TableProfile {
+        match model {
+            Model::Pbd => TableProfile::BeamDiffusion,
+            Model::Directional | Model::Dipole => TableProfile::Dipole,
+        }
+    }
 }
 
 /// One opaque object on the GPU.
@@ -178,6 +198,7 @@ impl GpuWorld {
             },
         )?;
         let diffusion = desc.integration.diffusion;
+        let table = TableProfile::of(desc.integration.model);
         let bounds: Vec<(Vec3, Vec3)> = world.objects.iter().map(|o| o.world_mesh().bounds()).collect();
         let opaque_bounds = world.opaque.iter().map(|o| o.world_mesh().bounds()).reduce(union);
         for (i, (object, &point_count)) in world.objects.iter().zip(&point_counts).enumerate() {
@@ -192,6 +213,7 @@ impl GpuWorld {
                     mesh: mesh.into_owned(),
                     material: object.material.clone(),
                     diffusion,
+                    table,
                     mm_per_unit: world.mm_per_unit,
                     samples: object.samples,
                 };
@@ -231,6 +253,7 @@ impl GpuWorld {
             let params_changed = remade
                 || object.material != g.made_from.material
                 || diffusion != g.made_from.diffusion
+                || table != g.made_from.table
                 || world.mm_per_unit != g.made_from.mm_per_unit;
             if mesh_changed {
                 g.made_from.mesh = mesh.into_owned();
@@ -239,7 +262,8 @@ impl GpuWorld {
             if params_changed {
                 g.made_from.material = object.material.clone();
                 (g.made_from.diffusion, g.made_from.mm_per_unit) = (diffusion, world.mm_per_unit);
-                write_params(&mut g.params, &mut g.dipole_table, &g.made_from, point_count)?;
+                g.made_from.table = table;
+                write_params(&mut g.params, &mut g.sd_table, &g.made_from, point_count)?;
             }
         }
         self.sync_opaque(ctx, world, desc, (relayout, shadow_resolution), bounds.into_iter().reduce(union))?;
@@ -322,14 +346,14 @@ impl GpuObject {
             BufferUsageFlags::UNIFORM_BUFFER,
             MemoryLocation::CpuToGpu,
         )?;
-        let mut dipole_table = Buffer::new(
+        let mut sd_table = Buffer::new(
             ctx,
-            "dipole Sd table",
-            (crate::gpu::dipole_table::TABLE_SIZE * 16) as u64, // a header texel and TABLE_SIZE - 1 pairs
+            "Sd table",
+            (crate::gpu::sd_table::TABLE_SIZE * 16) as u64, // a header texel and TABLE_SIZE - 1 pairs
             BufferUsageFlags::UNIFORM_TEXEL_BUFFER,
             MemoryLocation::CpuToGpu,
         )?;
-        write_params(&mut params, &mut dipole_table, &made_from, options.point_count)?;
+        write_params(&mut params, &mut sd_table, &made_from, options.point_count)?;
         Ok(GpuObject {
             hierarchy,
             vertices,
@@ -337,7 +361,7 @@ impl GpuObject {
             index_count,
             bounds: made_from.mesh.bounds(),
             params,
-            dipole_table,
+            sd_table,
             made_from,
         })
     }
@@ -352,7 +376,7 @@ fn upload_mesh(ctx: &Context, mesh: &Mesh) -> Result<(Buffer, Buffer, u32)> {
     Ok((vertices, indices, index_count))
 }
 
-/// Writes an object's parameters and its dipole table from what it is made from.
+/// Writes an object's parameters and its Sd table from what it is made from.
 fn write_params(params: &mut Buffer, table: &mut Buffer, from: &MadeFrom, point_count: u32) -> Result<()> {
     let constants = |c: usize| from.material.channel(c).constants(from.diffusion);
     params.write(
@@ -365,5 +389,11 @@ fn write_params(params: &mut Buffer, table: &mut Buffer, from: &MadeFrom, point_
             pad: 0,
         }],
     )?;
-    table.write(0, &SdTable::new(&[0, 1, 2].map(constants)).texels())
+    let sd_table = match from.table {
+        TableProfile::Dipole => SdTable::dipole(&[0, 1, 2].map(constants)),
+        TableProfile::BeamDiffusion => {
+            SdTable::beam_diffusion(&[0, 1, 2].map(|c| BeamMedium::new(&from.material.channel(c))))
+        }
+    };
+    table.write(0, &sd_table.texels())
 }

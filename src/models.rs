@@ -1,9 +1,10 @@
 //! The BSSRDF models, each registered once: its name (flags, scripts, the panel), its GPU code (the
 //! shade pipeline's specialisation constant and `bssrdf --gpu`'s push constant) and where its
 //! physics is. Adding a model is its physics module (src/physics/), its GLSL include
-//! (shaders/include/), a `Model` variant and one entry in [`MODELS`].
+//! (shaders/include/) or a tabulated profile (`gpu::SdTable`, as photon beam diffusion), a `Model`
+//! variant and one entry in [`MODELS`].
 
-use crate::gpu::{MODEL_DIPOLE, MODEL_DIRECTIONAL};
+use crate::gpu::{MODEL_DIPOLE, MODEL_DIRECTIONAL, MODEL_PBD};
 use crate::physics::Model;
 
 /// One model's registration.
@@ -39,6 +40,14 @@ pub const MODELS: &[ModelEntry] = &[
         label: "classical",
         gpu_code: MODEL_DIPOLE,
         about: "the classical dipole (Jensen, Marschner, Levoy, Hanrahan 2001)",
+    },
+    ModelEntry {
+        model: Model::Pbd,
+        name: "pbd",
+        aliases: &["beam-diffusion"],
+        label: "beam diffusion",
+        gpu_code: MODEL_PBD,
+        about: "photon beam diffusion, multiple and single scattering (Habel, Christensen, Jarosz 2013)",
     },
 ];
 
@@ -96,8 +105,10 @@ mod tests {
             }
         }
         assert_eq!(Model::from_name("classical"), Some(Model::Dipole));
+        assert_eq!(Model::from_name("beam-diffusion"), Some(Model::Pbd));
         assert_eq!(Model::Directional.next(), Model::Dipole);
-        assert_eq!(Model::Dipole.next(), Model::Directional);
-        assert_eq!(Model::names(), "directional or dipole");
+        assert_eq!(Model::Dipole.next(), Model::Pbd);
+        assert_eq!(Model::Pbd.next(), Model::Directional);
+        assert_eq!(Model::names(), "directional, dipole or pbd");
     }
 }

@@ -114,6 +114,7 @@ fn bssrdf_structs_match_glsl() {
         offset_of!(BssrdfQueryGpu, wi) as u32,
         offset_of!(BssrdfQueryGpu, xo) as u32,
         offset_of!(BssrdfQueryGpu, no) as u32,
+        offset_of!(BssrdfQueryGpu, table) as u32,
     ];
     assert_eq!(query, rust);
 }
@@ -218,6 +219,7 @@ fn shared_constants_are_the_rust_ones() {
     let value = |name: &str| GLSL_CONSTANTS.iter().find(|(n, _)| *n == name).map(|(_, v)| *v);
     assert_eq!(value("MODEL_DIRECTIONAL"), Some(Model::Directional.gpu_code()));
     assert_eq!(value("MODEL_DIPOLE"), Some(Model::Dipole.gpu_code()));
+    assert_eq!(value("MODEL_PBD"), Some(Model::Pbd.gpu_code()));
     assert_ne!(Model::Directional.gpu_code(), Model::Dipole.gpu_code());
     assert_eq!(value("LEAF_BIT"), Some(gpu::LEAF_BIT));
     assert_eq!(value("RADIX_TILE"), Some(gpu::RADIX_TILE));

@@ -1,5 +1,6 @@
 // The BSSRDF in f32, mirroring src/physics/ (f64): exact Fresnel, the classical dipole
-// (Jensen et al. 2001) and the directional dipole (Frisvad et al. 2014). Material constants come
+// (Jensen et al. 2001), the directional dipole (Frisvad et al. 2014) and the tabulated radial
+// profiles (the classical dipole's, photon beam diffusion's: Habel et al. 2013). Material constants come
 // precomputed in f64 on the CPU (BssrdfChannel = GpuChannel in src/gpu/subsurface.rs): the 3C2
 // polynomial behind CE cancels from ~1600 to ~0.4 and must not be evaluated in f32.
 // Conventions: normals outward, wi from the surface toward the light, eta = n_inside/n_outside.
@@ -53,21 +54,24 @@ float dipole_sd(BssrdfChannel c, float r) {
     return c.dipole_scale * (real_term + virtual_term) * (1.0 / 3.14159265358979323846);
 }
 
-// The classical dipole's Sd per channel from its table (mirrors physics::dipole::SdTable):
-// entry i holds Sd / scale (scale = Sd(0)/2^15, f16 stays normal down to 2e-9 Sd(0)) at
-// u = i/(DIPOLE_TABLE_SIZE - 1) of u = r/(r + reach), r in mm,
+// A radial Sd per channel from its table (mirrors gpu::SdTable; the classical dipole's or photon
+// beam diffusion's): entry i holds Sd / scale (scale = the peak / 2^15, f16 stays normal down to
+// 2e-9 of it) at u = i/(DIPOLE_TABLE_SIZE - 1) of u = r/(r + reach), r in mm,
 // linear between entries. Texel 0 (`header`, read once) holds the scales and the reach;
 // texel 1 + i holds entries i and i + 1 per channel as two f16, so a lookup is one fetch where
-// the closed form costs 6 square roots, exponentials and divisions.
-// DIPOLE_TABLE_SIZE comes from src/gpu/constants.rs.
-vec4 dipole_table_header(usamplerBuffer table) { return uintBitsToFloat(texelFetch(table, 0)); }
-vec3 dipole_sd_table(usamplerBuffer table, vec4 header, float r) {
+// the classical dipole's closed form costs 6 square roots, exponentials and divisions.
+// DIPOLE_TABLE_SIZE comes from src/gpu/constants.rs. `base`: the table's first texel where
+// several lie end to end (bssrdf_eval.comp), DIPOLE_TABLE_SIZE texels each.
+vec4 sd_table_header_at(usamplerBuffer table, int base) { return uintBitsToFloat(texelFetch(table, base)); }
+vec3 sd_table_at(usamplerBuffer table, int base, vec4 header, float r) {
     float x = r / (r + header.w) * float(DIPOLE_TABLE_SIZE - 1u);
     float i = min(floor(x), float(DIPOLE_TABLE_SIZE - 2u));
-    uvec3 pairs = texelFetch(table, int(i) + 1).xyz;
+    uvec3 pairs = texelFetch(table, base + int(i) + 1).xyz;
     vec2 red = unpackHalf2x16(pairs.x), green = unpackHalf2x16(pairs.y), blue = unpackHalf2x16(pairs.z);
     return header.xyz * mix(vec3(red.x, green.x, blue.x), vec3(red.y, green.y, blue.y), x - i);
 }
+vec4 dipole_table_header(usamplerBuffer table) { return sd_table_header_at(table, 0); }
+vec3 dipole_sd_table(usamplerBuffer table, vec4 header, float r) { return sd_table_at(table, 0, header, r); }
 
 // The ray-source term S'(x, w, r) of the directional dipole.
 float dirpole_source(BssrdfChannel c, vec3 x, vec3 w, float r, vec3 no) {

@@ -8,6 +8,8 @@
 pub const MODEL_DIRECTIONAL: u32 = 0;
 /// The same for the classical dipole.
 pub const MODEL_DIPOLE: u32 = 1;
+/// The same for photon beam diffusion (read from its Sd table like the classical dipole's).
+pub const MODEL_PBD: u32 = 2;
 
 /// Set in a tree node's child index when the child is a point (index into the sorted points).
 pub const LEAF_BIT: u32 = 0x8000_0000;
@@ -27,13 +29,15 @@ pub const MAX_CUT_STEPS: u32 = 24000;
 /// Evaluations in one tile's list (the shade pass loops once per evaluation), past which the cut
 /// pass uses nodes whole.
 pub const MAX_LIST_EVALUATIONS: u32 = 16384;
-/// Entries of the classical dipole's Sd table (`gpu::SdTable`, bssrdf.glsl).
+/// Entries of an Sd table (`gpu::SdTable`, bssrdf.glsl): the classical dipole's and photon beam
+/// diffusion's.
 pub const DIPOLE_TABLE_SIZE: u32 = 4096;
 
 /// Every constant of the GLSL header, by its GLSL name.
 pub const GLSL_CONSTANTS: &[(&str, u32)] = &[
     ("MODEL_DIRECTIONAL", MODEL_DIRECTIONAL),
     ("MODEL_DIPOLE", MODEL_DIPOLE),
+    ("MODEL_PBD", MODEL_PBD),
     ("LEAF_BIT", LEAF_BIT),
     ("RADIX_TILE", RADIX_TILE),
     ("TILE_SIZE", TILE_SIZE),

@@ -6,7 +6,8 @@
 //! - `lights`: lights.glsl;
 //! - `subsurface`: shading_params.glsl (per object, per frame) and bssrdf.glsl's per-channel
 //!   constants;
-//! - `dipole_table`: the classical dipole's Sd table as bssrdf.glsl reads it (f16 pairs);
+//! - `sd_table`: the tabulated Sd(r) of the classical dipole and of photon beam diffusion as
+//!   bssrdf.glsl reads it (f16 pairs);
 //! - `shade`: shade_constants.glsl and shade.frag's work counters;
 //! - `passes`: the other passes' push constants and blocks (bssrdf_eval.comp, tonemap.comp, the
 //!   hierarchy's compute shaders, the debug views);
@@ -14,17 +15,17 @@
 //!   `gpu_constants.glsl`.
 
 pub mod constants;
-pub mod dipole_table;
 pub mod lights;
 pub mod passes;
 pub mod points;
+pub mod sd_table;
 pub mod shade;
 pub mod subsurface;
 
 pub use constants::*;
-pub use dipole_table::SdTable;
 pub use lights::*;
 pub use passes::*;
 pub use points::*;
+pub use sd_table::SdTable;
 pub use shade::*;
 pub use subsurface::*;

@@ -8,7 +8,7 @@ use crate::output::{self, HIST_BINS, HIST_BINS_PER_STOP, HIST_LOG2_MIN};
 
 use super::GpuChannel;
 
-/// Mirrors `BssrdfQuery` in shaders/bssrdf_eval.comp (std430: 64 + 5 × 16 bytes).
+/// Mirrors `BssrdfQuery` in shaders/bssrdf_eval.comp (std430: 64 + 6 × 16 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct BssrdfQueryGpu {
@@ -18,6 +18,8 @@ pub struct BssrdfQueryGpu {
     pub wi: Vec4,
     pub xo: Vec4,
     pub no: Vec4,
+    /// x: the row's Sd table among the dispatch's (photon beam diffusion); the rest unused.
+    pub table: [u32; 4],
 }
 
 /// Mirrors the push constants of shaders/bssrdf_eval.comp.

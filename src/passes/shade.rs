@@ -51,8 +51,8 @@ pub struct ShadeInputs<'a> {
     pub point_lights: &'a Buffer,
     pub point_flux: &'a Buffer,
     pub node_flux: &'a Buffer,
-    /// The classical dipole's Sd table (`physics::dipole::SdTable`).
-    pub dipole_table: &'a Buffer,
+    /// The object's Sd table (`gpu::SdTable`: the classical dipole's or beam diffusion's).
+    pub sd_table: &'a Buffer,
     /// The tile-cut pass's lists (headers and entries).
     pub tile_headers: &'a Buffer,
     pub tile_entries: &'a Buffer,
@@ -250,7 +250,7 @@ impl ShadePass {
             Bind::StorageImageRead(inputs.normal),
             Bind::Texels(inputs.tile_headers),
             Bind::Texels(inputs.tile_entries),
-            Bind::Texels(inputs.dipole_table),
+            Bind::Texels(inputs.sd_table),
             Bind::Uniform(inputs.frame_params),
             Bind::Texels(inputs.point_flux),
         ];

@@ -161,6 +161,10 @@ pub struct RteTally {
     pub total: f64,
     /// Its standard error.
     pub total_error: f64,
+    /// The part of `total` that left after exactly one scattering (single scattering), and its
+    /// standard error.
+    pub single: f64,
+    pub single_error: f64,
     /// Outgoing radiance per unit irradiance in `RADIANCE_BINS` bins of equal projected solid
     /// angle, bin k covering cos²θo in [k, k+1)/RADIANCE_BINS.
     pub radiance: Vec<f64>,
@@ -219,9 +223,11 @@ pub fn rte_reflectance(albedo: f64, eta: f64, cos_i: f64, photons: u64, seed: u6
     let entry = fresnel::transmittance(eta, cos_i);
     let mut escaped = vec![0u64; RADIANCE_BINS];
     let mut count = 0u64;
+    let mut once = 0u64;
     for _ in 0..photons {
         let mut z = 0.0f64;
         let mut d = start;
+        let mut scatterings = 0u32;
         loop {
             let s = -rng.next().ln();
             let z_next = z + s * d.z;
@@ -236,12 +242,14 @@ pub fn rte_reflectance(albedo: f64, eta: f64, cos_i: f64, photons: u64, seed: u6
                 let k = ((mu_o2.clamp(0.0, 1.0) * RADIANCE_BINS as f64) as usize).min(RADIANCE_BINS - 1);
                 escaped[k] += 1;
                 count += 1;
+                once += (scatterings == 1) as u64;
                 break;
             }
             z = z_next;
             if rng.next() >= albedo {
                 break;
             }
+            scatterings += 1;
             let mu = 2.0 * rng.next() - 1.0;
             let phi = 2.0 * PI * rng.next();
             let s = (1.0 - mu * mu).max(0.0).sqrt();
@@ -250,9 +258,12 @@ pub fn rte_reflectance(albedo: f64, eta: f64, cos_i: f64, photons: u64, seed: u6
     }
     let n = photons as f64;
     let p = count as f64 / n;
+    let p1 = once as f64 / n;
     RteTally {
         total: entry * p,
         total_error: entry * (p * (1.0 - p) / n).sqrt(),
+        single: entry * p1,
+        single_error: entry * (p1 * (1.0 - p1) / n).sqrt(),
         // Bin k's projected solid angle is π/RADIANCE_BINS.
         radiance: escaped.iter().map(|&c| entry * c as f64 / n / (PI / RADIANCE_BINS as f64)).collect(),
     }

@@ -5,6 +5,7 @@
 //! Conventions (see `shared/reference/bssrdf.md`): per colour channel, coefficients in mm⁻¹,
 //! lengths in mm, normals outward, ωi from the surface toward the light, η = n_inside/n_outside.
 
+pub mod beam_diffusion;
 pub mod dipole;
 pub mod dirpole;
 pub mod fresnel;
@@ -29,6 +30,8 @@ pub enum Model {
     Directional,
     /// Jensen, Marschner, Levoy, Hanrahan 2001.
     Dipole,
+    /// Photon beam diffusion, multiple and single scattering: Habel, Christensen, Jarosz 2013.
+    Pbd,
 }
 
 /// One colour channel of a medium.
@@ -131,6 +134,9 @@ impl Query {
         match model {
             Model::Directional => dirpole::sd(&c, self.xi, self.ni, self.wi, self.xo, self.no),
             Model::Dipole => dipole::sd(&c, (self.xo - self.xi).length()),
+            Model::Pbd => {
+                beam_diffusion::sd(&beam_diffusion::BeamMedium::new(&self.medium), (self.xo - self.xi).length())
+            }
         }
     }
 }
