@@ -14,7 +14,7 @@ const float PI = 3.14159265358979;
 
 // Mitsuba 3's latitude-longitude convention (environment.rs `direction_to_uv`).
 vec2 latlong_uv(vec3 d) {
-    float u = (atan(d.x, -d.z) + PI) / (2.0 * PI);
+    float u = atan(d.x, -d.z) / (2.0 * PI);
     return vec2(fract(u), acos(clamp(d.y, -1.0, 1.0)) / PI);
 }
 

@@ -280,23 +280,44 @@ pub fn run(options: &BenchOptions) -> Result<String> {
             );
             crate::note!("bench: epsilon {eps} done");
         }
-        // 4. Cost against the number of lights: each light is its own source.
+        // 4. Cost against the number of lights: every light in one merged record per point and
+        // node; the error against exact per-light brute force at a smaller size (brute force
+        // costs pixels × points × lights), up to 64 lights.
+        let e = options.accuracy_size.min(32);
         out += &format!(
-            "\n### Lights\n\n{} at {s}x{s}, {n} points, ε = {DEFAULT_EPSILON}, subsurface term only; lights alternate directional and point, all reaching most of the mesh.\n\n| lights | shade ms | per light ms | Sd evaluations/px |\n|---:|---:|---:|---:|\n",
+            "\n### Lights\n\n{} at {s}x{s}, {n} points, ε = {DEFAULT_EPSILON}, subsurface term only; directional lights on a spiral over the upper hemisphere (total irradiance 1), or a synthetic sky (`--env sky`) in 64 directions. Error: relative RMSE at {e}x{e} against brute force, which sums every (point, light) pair exactly.\n\n| lights | shade ms | Sd evaluations/px | error against exact |\n|---:|---:|---:|---:|\n",
             mesh_name(spec),
             s = options.accuracy_size
         );
-        for count in [1usize, 2, 4, 8] {
+        let sky = crate::environment::Environment {
+            name: "sky".into(),
+            radiance: crate::environment::sky(30.0, 30.0),
+            scale: 1.0,
+            to_world: glam::Mat3::IDENTITY,
+            samples: 64,
+        };
+        let cases: Vec<(String, Vec<Light>)> = [1usize, 8, 64, 256]
+            .iter()
+            .map(|&k| (k.to_string(), spiral_lights(k)))
+            .chain(std::iter::once(("sky, 64 directions".to_string(), sky.lights()?)))
+            .collect();
+        for (name, lights) in cases {
             let mut lit = scene.clone();
-            lit.lights = bench_lights(&scene, count);
+            lit.lights = lights;
             let run = run_one(&options.context, &lit, n, size, options.frames, DEFAULT_EPSILON, false, false)?;
-            let shade = pass_ms(&run, "shade");
+            let error = if lit.lights.len() <= 64 && e > 0 {
+                let tree = run_one(&options.context, &lit, n, (e, e), 1, DEFAULT_EPSILON, false, false)?;
+                let exact = run_one(&options.context, &lit, n, (e, e), 1, DEFAULT_EPSILON, true, false)?;
+                format!("{:.3}%", 100.0 * relative_rmse(&tree.image.pixels, &exact.image.pixels))
+            } else {
+                "—".to_string()
+            };
             out += &format!(
-                "| {count} | {shade:.1} | {:.1} | {:.1} |\n",
-                shade / count as f64,
+                "| {name} | {:.1} | {:.1} | {error} |\n",
+                pass_ms(&run, "shade"),
                 per_pixel(&run.work, run.work.evaluation_sum)
             );
-            crate::note!("bench: {count} light(s) done");
+            crate::note!("bench: {name} light(s) done");
         }
     }
     // 5. The peer users would pick instead.
@@ -367,20 +388,17 @@ fn scene_of_objects(options: &BenchOptions) -> Result<String> {
     Ok(out)
 }
 
-/// `count` lights around the mesh: the default back light first, then point and directional
-/// lights in turn, spread in azimuth, above the equator.
-fn bench_lights(scene: &Scene, count: usize) -> Vec<Light> {
-    let (centre, radius) = bounding_sphere(&scene.mesh.positions);
+/// `count` directional lights on a golden-angle spiral over the upper hemisphere (the default
+/// back light's side first), of total irradiance 1.
+fn spiral_lights(count: usize) -> Vec<Light> {
     (0..count)
         .map(|k| {
-            let angle = k as f32 * std::f32::consts::TAU / count as f32;
-            let toward =
-                Vec3::new(-0.3 * angle.cos() - 0.65 * angle.sin(), 0.7, -0.65 * angle.cos() + 0.3 * angle.sin());
-            if k % 2 == 0 {
-                Light::Directional { toward, irradiance: Vec3::ONE / count as f32 }
-            } else {
-                let position = centre + toward.normalize() * radius * 3.0;
-                Light::Point { position, intensity: Vec3::splat(9.0 * radius * radius / count as f32) }
+            let y = 1.0 - (k as f32 + 0.5) / count as f32 * 0.9; // from near the zenith to 6° up
+            let r = (1.0 - y * y).max(0.0).sqrt();
+            let phi = k as f32 * 2.399_963 + 3.6; // the golden angle; 3.6 rad: behind, as the default light
+            Light::Directional {
+                toward: Vec3::new(r * phi.cos(), y, r * phi.sin()),
+                irradiance: Vec3::ONE / count as f32,
             }
         })
         .collect()

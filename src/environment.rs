@@ -5,8 +5,8 @@
 //! visibility and converges as K grows.
 //!
 //! Directions: world space, +y up. A latitude-longitude map follows Mitsuba 3's `envmap` (so that
-//! `export mitsuba` can hand it the same file): u = (1 + atan2(x, −z)/π)/2 across, v = acos(y)/π
-//! down. An equal-area octahedral map follows pbrt-v4's `EqualAreaSquareToSphere` (Clarberg 2008)
+//! `export mitsuba` can hand it the same file, src/emitters/envmap.cpp): u = atan2(x, −z)/2π
+//! (mod 1) across, v = acos(y)/π down: the left edge looks along −z, a quarter across along +x. An equal-area octahedral map follows pbrt-v4's `EqualAreaSquareToSphere` (Clarberg 2008)
 //! in the light's own frame, z up there; pbrt scenes give the frame with the light's transform.
 
 use std::f64::consts::PI;
@@ -121,7 +121,8 @@ impl Environment {
         if !(self.scale.is_finite() && self.scale >= 0.0) {
             return Err(bad_input!("--env-scale {}: must be finite and ≥ 0", self.scale));
         }
-        if !self.to_world.is_finite() || (self.to_world.determinant() - 1.0).abs() > 1e-3 {
+        // A rotation, or a mirrored one (a left-handed pbrt scene is mirrored into ours).
+        if !self.to_world.is_finite() || (self.to_world.determinant().abs() - 1.0).abs() > 1e-3 {
             return Err(bad_input!("{}: the environment's frame must be a rotation", self.name));
         }
         if self.samples == 0 || self.samples > MAX_SAMPLES {
@@ -282,8 +283,8 @@ pub fn solid_angle(layout: Layout, width: u32, height: u32, y: u32) -> f64 {
 pub fn uv_to_direction(layout: Layout, u: f64, v: f64) -> DVec3 {
     match layout {
         Layout::LatLong => {
-            // Mitsuba 3 envmap: φ = 2πu − π measured from −z toward +x, θ = πv from +y.
-            let (phi, theta) = (2.0 * PI * u - PI, PI * v);
+            // Mitsuba 3 envmap: φ = 2πu measured from −z toward +x, θ = πv from +y.
+            let (phi, theta) = (2.0 * PI * u, PI * v);
             DVec3::new(theta.sin() * phi.sin(), theta.cos(), -theta.sin() * phi.cos())
         }
         Layout::Octahedral => equal_area_square_to_sphere(u, v),
@@ -294,8 +295,7 @@ pub fn uv_to_direction(layout: Layout, u: f64, v: f64) -> DVec3 {
 pub fn direction_to_uv(layout: Layout, d: DVec3) -> (f64, f64) {
     match layout {
         Layout::LatLong => {
-            let phi = d.x.atan2(-d.z);
-            let u = (phi + PI) / (2.0 * PI);
+            let u = d.x.atan2(-d.z) / (2.0 * PI);
             let v = d.y.clamp(-1.0, 1.0).acos() / PI;
             (u.rem_euclid(1.0), v)
         }
@@ -365,9 +365,11 @@ mod tests {
             let total: f64 = (0..h).map(|y| w as f64 * solid_angle(layout, w, h, y)).sum();
             assert!((total - 4.0 * PI).abs() < 1e-9, "{layout:?}: {total}");
         }
-        // Mitsuba's latitude-longitude convention: the centre column looks down −z... +y at the top.
-        assert!((uv_to_direction(Layout::LatLong, 0.5, 0.5) - DVec3::NEG_Z).length() < 1e-12);
-        assert!((uv_to_direction(Layout::LatLong, 0.75, 0.5) - DVec3::X).length() < 1e-12);
+        // Mitsuba's latitude-longitude convention: the left edge looks along −z, a quarter
+        // across along +x, half across along +z; +y at the top.
+        assert!((uv_to_direction(Layout::LatLong, 0.0, 0.5) - DVec3::NEG_Z).length() < 1e-12);
+        assert!((uv_to_direction(Layout::LatLong, 0.25, 0.5) - DVec3::X).length() < 1e-12);
+        assert!((uv_to_direction(Layout::LatLong, 0.5, 0.5) - DVec3::Z).length() < 1e-12);
         assert!((uv_to_direction(Layout::LatLong, 0.3, 0.0) - DVec3::Y).length() < 1e-12);
     }
 

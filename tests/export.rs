@@ -267,7 +267,7 @@ fn opaque_objects_are_diffuse_and_every_number_is_finite() {
     let camera = Camera { eye: DVec3::new(0.0, 10.0, 30.0), target: DVec3::ZERO, up: DVec3::Y, fov_y_deg: 35.0 };
     let lights = [Light::Directional { toward: DVec3::new(0.0, 3.0, 4.0), irradiance: [1.0; 3] }];
     let written =
-        write_scene(&dir, &camera, &lights, &objects, &Options { light_radius_deg: 2.0, ..Options::default() })
+        write_scene(&dir, &camera, (&lights, None), &objects, &Options { light_radius_deg: 2.0, ..Options::default() })
             .unwrap();
     let xml = std::fs::read_to_string(&written.scene).unwrap();
     assert_eq!(written.meshes.len(), 2);
@@ -285,9 +285,15 @@ fn opaque_objects_are_diffuse_and_every_number_is_finite() {
     assert!(close(radiance[0], disk_radiance(1.0, 2.0), 1e-15));
     assert!(!xml.contains("NaN") && !xml.contains("inf"));
     // Nothing to export, a light radius out of range: bad input.
-    assert!(write_scene(&dir, &camera, &lights, &[], &Options::default()).is_err());
-    assert!(write_scene(&dir, &camera, &lights, &objects, &Options { light_radius_deg: 90.0, ..Options::default() })
-        .is_err());
+    assert!(write_scene(&dir, &camera, (&lights, None), &[], &Options::default()).is_err());
+    assert!(write_scene(
+        &dir,
+        &camera,
+        (&lights, None),
+        &objects,
+        &Options { light_radius_deg: 90.0, ..Options::default() }
+    )
+    .is_err());
 }
 
 #[test]
@@ -338,4 +344,30 @@ fn bad_export_options_exit_2_naming_the_flag() {
         &["export", "mitsuba", "--mesh", "sphere", "--material", "nope", "--out", dir.to_str().unwrap()],
         "nope",
     );
+}
+
+/// An environment is exported whole, not as its samples: a constant one as Mitsuba's `constant`
+/// emitter, a map as an `envmap` of a latitude-longitude EXR in Mitsuba's convention (the sky's
+/// sun lands in the texel whose direction is the sun's).
+#[test]
+fn environments_are_exported_whole() {
+    let (dir, xml) = export("env-const", &["--mesh", "sphere", "--env", "const:0.5", "--env-samples", "16"]);
+    assert!(
+        xml.contains("<emitter type=\"constant\"><rgb name=\"radiance\" value=\"0.5, 0.5, 0.5\"/></emitter>"),
+        "{xml}"
+    );
+    assert_eq!(xml.matches("type=\"disk\"").count(), 0, "the environment's samples are not exported as lights");
+    assert!(!dir.join("environment.exr").exists());
+    let (dir, xml) = export("env-sky", &["--mesh", "sphere", "--env", "sky:30:90", "--light", "dir:0,1,0:0.5"]);
+    assert!(
+        xml.contains("<emitter type=\"envmap\"><string name=\"filename\" value=\"environment.exr\"/></emitter>"),
+        "{xml}"
+    );
+    assert_eq!(xml.matches("type=\"disk\"").count(), 1, "the one --light");
+    let img = image::open(dir.join("environment.exr")).unwrap().into_rgb32f();
+    assert_eq!(img.dimensions(), (512, 256));
+    // The sun at elevation 30°, azimuth 90° (toward +x): Mitsuba's u = atan2(x, −z)/2π = 0.25.
+    let (x, y) = (img.width() / 4, (img.height() as f32 * (60.0 / 180.0)) as u32);
+    assert!(img.get_pixel(x, y)[0] > 100.0, "{:?}", img.get_pixel(x, y));
+    assert!(img.get_pixel(img.width() * 3 / 4, y)[0] < 1.0);
 }

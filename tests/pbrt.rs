@@ -259,13 +259,34 @@ fn scenes_render_with_pbrts_handedness_and_flags_override() {
     assert_eq!(out.status.code(), Some(0), "{}", common::stderr(&out));
     let img = image::open(&out_png).unwrap();
     assert_eq!((img.width(), img.height()), (20, 24));
-    // What is not rendered yet is refused, naming the line (opaque shapes of constant,
-    // checkerboard and image reflectance render: tests/scenes.rs).
-    let infinite = write(&d, "infinite.pbrt", &(scene("", 0.0) + "LightSource \"infinite\" \"rgb L\" [ 1 1 1 ]\n"));
-    let out = render(&[infinite.to_str().unwrap()]);
+    // An `infinite` light of constant L renders as `--env const:L` beside the scene's distant
+    // light given as a flag: the same lights in the same order, bit for bit. Its frame follows
+    // its transform and pbrt's left-handed camera (both mirror in x here, so the map's samples
+    // come out where the flag's are).
+    let light = "AttributeBegin\nScale -1 1 1\nLightSource \"infinite\" \"rgb L\" [ 0.5 0.5 0.5 ]\nAttributeEnd\n";
+    let infinite = write(&d, "infinite.pbrt", &(scene("", 0.0) + light));
+    let plain = write(&d, "plain.pbrt", &scene("", 0.0));
+    let (a, b) = (d.join("infinite.exr"), d.join("flags.exr"));
+    let small = ["--samples", "4096", "--width", "24", "--height", "16", "--env-samples", "16"];
+    let out = render(&[&[infinite.to_str().unwrap(), "--out", a.to_str().unwrap()][..], &small].concat());
+    assert_eq!(out.status.code(), Some(0), "{}", common::stderr(&out));
+    let flags = ["--env", "const:0.5", "--light", "dir:0,0,-1:3", "--out", b.to_str().unwrap()];
+    let out = render(&[&[plain.to_str().unwrap()][..], &flags, &small].concat());
+    assert_eq!(out.status.code(), Some(0), "{}", common::stderr(&out));
+    let (ia, ib) = (image::open(&a).unwrap().into_rgba32f(), image::open(&b).unwrap().into_rgba32f());
+    assert!(ia.pixels().all(|p| p[3] == 1.0), "the environment covers the background");
+    assert!(ia == ib, "an infinite light and --env const: differ");
+    let missing =
+        write(&d, "missing.pbrt", &(scene("", 0.0) + "LightSource \"infinite\" \"string filename\" \"nope.exr\"\n"));
+    let out = render(&[missing.to_str().unwrap()]);
     let err = common::stderr(&out);
     assert_eq!(out.status.code(), Some(2), "{err}");
-    assert!(err.contains("infinite.pbrt:12:1: ") && err.contains("not rendered yet"), "{err}");
+    assert!(err.contains("missing.pbrt:12:1: ") && err.contains("nope.exr"), "{err}");
+    let sheared = write(&d, "sheared.pbrt", &(scene("", 0.0) + "Scale 2 1 1\nLightSource \"infinite\"\n"));
+    let out = render(&[sheared.to_str().unwrap()]);
+    let err = common::stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("sheared.pbrt:13:1: ") && err.contains("rotation"), "{err}");
     let bad = write(&d, "bad.pbrt", "WorldBegin\nShape \"cone\"\n");
     let out = render(&[bad.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2));

@@ -44,7 +44,13 @@ pub(super) fn mitsuba(args: &MitsubaArgs) -> Result<i32> {
         up: c.up.as_dvec3(),
         fov_y_deg: c.fov_y_deg as f64,
     };
-    let lights: Vec<Light> = desc.lights.iter().map(|l| light_in_mm(l, mm)).collect();
+    // An environment's samples are among the lights: it is exported whole instead.
+    let sampled = match &desc.environment {
+        Some(env) => env.lights()?.len(),
+        None => 0,
+    };
+    let explicit = &desc.lights[..desc.lights.len().saturating_sub(sampled)];
+    let lights: Vec<Light> = explicit.iter().map(|l| light_in_mm(l, mm)).collect();
     let meshes: Vec<_> = world.objects.iter().map(|o| o.world_mesh()).collect();
     let objects: Vec<Object> = world
         .objects
@@ -68,7 +74,7 @@ pub(super) fn mitsuba(args: &MitsubaArgs) -> Result<i32> {
         light_radius_deg: args.light_radius as f64,
         ..Options::default()
     };
-    let written = mitsuba::write_scene(dir, &camera, &lights, &objects, &options)?;
+    let written = mitsuba::write_scene(dir, &camera, (&lights, desc.environment.as_deref()), &objects, &options)?;
     for w in &written.warnings {
         crate::note!("warning: {w}");
     }

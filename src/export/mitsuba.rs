@@ -196,11 +196,13 @@ pub struct Written {
     pub warnings: Vec<String>,
 }
 
-/// Writes `scene.xml` and one PLY per object (in mm) into `dir`, which must exist.
+/// Writes `scene.xml` and one PLY per object (in mm) into `dir`, which must exist; an
+/// environment becomes Mitsuba's `constant` emitter, or an `envmap` of `environment.exr` (a
+/// latitude-longitude map in Mitsuba's convention, resampled from ours with its scale applied).
 pub fn write_scene(
     dir: &Path,
     camera: &Camera,
-    lights: &[Light],
+    (lights, environment): (&[Light], Option<&crate::environment::Environment>),
     objects: &[Object],
     options: &Options,
 ) -> Result<Written> {
@@ -410,6 +412,40 @@ pub fn write_scene(
                         num(cone_deg)
                     ));
                 }
+            }
+        }
+    }
+    if let Some(env) = environment {
+        use crate::environment::{uv_to_direction, Layout, Radiance};
+        match &env.radiance {
+            Radiance::Constant(l) => {
+                let _ = writeln!(w, "    <!-- the environment: constant radiance -->");
+                let _ = writeln!(
+                    w,
+                    "    <emitter type=\"constant\"><rgb name=\"radiance\" value=\"{}\"/></emitter>",
+                    triple((*l * env.scale).as_dvec3().to_array())
+                );
+            }
+            Radiance::Image { height, .. } => {
+                // Mitsuba reads latitude-longitude maps only: resampled at each of its texels'
+                // centres (the nearest texel of ours, as render reads it), the scale applied.
+                let h = *height;
+                let img = image::Rgb32FImage::from_fn(2 * h, h, |x, y| {
+                    let d = uv_to_direction(
+                        Layout::LatLong,
+                        (x as f64 + 0.5) / (2 * h) as f64,
+                        (y as f64 + 0.5) / h as f64,
+                    );
+                    image::Rgb(env.radiance_toward(d.as_vec3()).to_array())
+                });
+                let path = dir.join("environment.exr");
+                image::DynamicImage::ImageRgb32F(img).save(&path).map_err(|e| runtime!("{}: {e}", path.display()))?;
+                let _ =
+                    writeln!(w, "    <!-- the environment: {}, resampled to {}x{h} -->", xml_comment(&env.name), 2 * h);
+                let _ = writeln!(
+                    w,
+                    "    <emitter type=\"envmap\"><string name=\"filename\" value=\"environment.exr\"/></emitter>"
+                );
             }
         }
     }

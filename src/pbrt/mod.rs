@@ -113,10 +113,36 @@ pub struct Object {
 /// Lights in world space; `scale` as given (the renderer multiplies).
 #[derive(Clone, Debug)]
 pub enum LightDesc {
-    Distant { from: DVec3, to: DVec3, l: [f64; 3], scale: f64, loc: Loc },
-    Point { from: DVec3, i: [f64; 3], scale: f64, loc: Loc },
-    Spot { from: DVec3, to: DVec3, coneangle: f64, conedelta: f64, i: [f64; 3], scale: f64, loc: Loc },
-    Infinite { filename: Option<PathBuf>, l: Option<[f64; 3]>, scale: f64, loc: Loc },
+    Distant {
+        from: DVec3,
+        to: DVec3,
+        l: [f64; 3],
+        scale: f64,
+        loc: Loc,
+    },
+    Point {
+        from: DVec3,
+        i: [f64; 3],
+        scale: f64,
+        loc: Loc,
+    },
+    Spot {
+        from: DVec3,
+        to: DVec3,
+        coneangle: f64,
+        conedelta: f64,
+        i: [f64; 3],
+        scale: f64,
+        loc: Loc,
+    },
+    /// `frame`: the light's transform (the map's frame in the world; pbrt's maps are z up).
+    Infinite {
+        filename: Option<PathBuf>,
+        l: Option<[f64; 3]>,
+        scale: f64,
+        frame: glam::DMat3,
+        loc: Loc,
+    },
 }
 
 #[derive(Clone, Debug, Default)]
@@ -279,9 +305,6 @@ pub fn render_settings(
         return Err(bad_input!("--mesh: a scene file gives its own shapes; leave out --mesh or the scene"));
     }
     let shown = path.display();
-    let not_yet = |loc: &Loc, what: &str| {
-        bad_input!("{loc}: {what} not rendered yet (today a scene renders shapes with subsurface and diffuse materials, lit by distant, point and spot lights)")
-    };
     let mut translucent = Vec::new();
     let mut opaque = Vec::new();
     for o in &scene.objects {
@@ -295,6 +318,7 @@ pub fn render_settings(
         return Err(bad_input!("{shown}: no shape with a subsurface material (nothing to render)"));
     };
     let mut lights = Vec::new();
+    let mut environment: Option<crate::environment::Environment> = None;
     for l in &scene.lights {
         let rgb = |c: [f64; 3], s: f64| Vec3::new((c[0] * s) as f32, (c[1] * s) as f32, (c[2] * s) as f32);
         match l {
@@ -311,8 +335,34 @@ pub fn render_settings(
                 Light::spot(from.as_vec3(), to.as_vec3(), *coneangle as f32, *conedelta as f32, rgb(*i, *scale))
                     .map_err(|e| bad_input!("{loc}: LightSource \"spot\": {e}"))?,
             ),
-            LightDesc::Infinite { loc, .. } => {
-                return Err(not_yet(loc, "LightSource \"infinite\": environment lights are"))
+            LightDesc::Infinite { filename, l, scale, frame, loc } => {
+                if environment.is_some() {
+                    return Err(bad_input!(
+                        "{loc}: LightSource \"infinite\": one environment light per scene is rendered"
+                    ));
+                }
+                let shown = format!("{loc}: LightSource \"infinite\"");
+                let radiance = match (filename, l) {
+                    (Some(f), _) => crate::environment::Environment::load(f, &format!("{shown} \"{}\"", f.display()))?,
+                    (None, l) => crate::environment::Radiance::Constant(rgb(l.unwrap_or([1.0; 3]), 1.0)),
+                };
+                // Orthonormal columns: the map's frame (pbrt allows any transform; a scale or
+                // shear of directions has no meaning for an environment).
+                let f = frame.as_mat3();
+                let ortho = [f.x_axis, f.y_axis, f.z_axis].iter().all(|c| (c.length() - 1.0).abs() < 1e-3)
+                    && f.x_axis.dot(f.y_axis).abs() < 1e-3
+                    && f.y_axis.dot(f.z_axis).abs() < 1e-3
+                    && f.x_axis.dot(f.z_axis).abs() < 1e-3;
+                if !ortho {
+                    return Err(bad_input!("{shown}: its transform must be a rotation"));
+                }
+                environment = Some(crate::environment::Environment {
+                    name: shown,
+                    radiance,
+                    scale: *scale as f32,
+                    to_world: f,
+                    samples: args.env_samples,
+                });
             }
         }
     }
@@ -409,8 +459,21 @@ pub fn render_settings(
     if given("--fov") {
         cam.fov_y_deg = args.fov;
     }
-    if given("--light") || given("--light-dir") || given("--light-intensity") || lights.is_empty() {
-        if lights.is_empty() && !given("--light") && !given("--light-dir") {
+    if given("--env") {
+        environment = None; // the flag's environment replaces the scene's
+    }
+    if let Some(env) = environment.as_mut() {
+        if camera.left_handed {
+            let m = glam::DMat3::from_cols(mirror_v(DVec3::X), mirror_v(DVec3::Y), mirror_v(DVec3::Z));
+            env.to_world = (m * env.to_world.as_dmat3()).as_mat3();
+        }
+        lights.extend(env.lights()?);
+    }
+    let flags_light = given("--light") || given("--light-dir") || given("--light-intensity") || given("--env");
+    if flags_light || lights.is_empty() {
+        // The flags' lights (and environment) replace the scene's.
+        environment = None;
+        if lights.is_empty() && !given("--light") && !given("--light-dir") && !given("--env") {
             crate::note!("warning: {shown}: no distant or point light: the default light is used");
         }
         lights = settings.desc.lights.clone();
@@ -482,6 +545,9 @@ pub fn render_settings(
     }
     settings.world = world;
     (settings.desc.camera, settings.desc.lights) = (cam, lights);
+    if let Some(env) = environment {
+        settings.desc.environment = Some(std::sync::Arc::new(env));
+    }
     settings.desc.validate()?;
     settings.world.validate()?;
     Ok((out, settings))

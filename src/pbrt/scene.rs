@@ -626,7 +626,8 @@ impl Parser {
             "infinite" => {
                 let filename = p.string("filename")?.map(|f| dir.join(f));
                 let l = if filename.is_none() { Some(colour("L")?) } else { None };
-                LightDesc::Infinite { filename, l, scale, loc: loc.clone() }
+                let frame = glam::DMat3::from_mat4(m);
+                LightDesc::Infinite { filename, l, scale, frame, loc: loc.clone() }
             }
             other => {
                 return Err(err(
