@@ -176,3 +176,127 @@ fn bad_environments_are_refused_by_name() {
     assert_bad_env(&["--env", "const:1", "--env-scale", "-2"], "--env-scale");
     assert_bad_env(&["--env", "sky:100:0"], "sky");
 }
+
+/// A thick slab (8 × 8 × 2 mm, σa = 1, 0.5, 2 and σs = 2, 3, 1 per mm, η = 1.3, as in
+/// tests/subsurface.rs) under a uniform environment L = 1 in 256 directions, seen from straight
+/// above: the centre pixel against the closed forms of a half-space lit from the whole upper
+/// hemisphere. Classical dipole: Ft(0) · E · Rd/π with E = 2π∫Ft(μ)μ dμ. Directional dipole:
+/// Ft(0) · 2π∫ Ft(μ) μ P(μ) dμ, P(μ) its f64 plane integral for light at cos θ = μ (by symmetry
+/// the same for every azimuth). The classical dipole within 2%, as the single-light slab tests
+/// (sampling, the slab's finite size and its lit bottom; measured +0.3%, +0.7%). The directional
+/// dipole is held to 5%, a known shortfall and not the goal: measured 2.8–4.1% high, of which the
+/// 256 directions account for 0.15% (the same sum over the lights themselves, printed) and the
+/// rest is the merged records' (lights over the whole hemisphere, their worst case: the real
+/// source's distance dr is not affine in the refracted direction, see tests/lights.rs).
+#[test]
+fn thick_slab_under_a_uniform_environment_equals_the_closed_forms() {
+    use glam::DVec3;
+    use translucent::physics::{dipole, dirpole, Diffusion, Medium, Model};
+    let eta = 1.3;
+    let medium = |ch: usize| {
+        let (sigma_a, sigma_s) = [(1.0, 2.0), (0.5, 3.0), (2.0, 1.0)][ch];
+        Medium { sigma_a, sigma_s, g: 0.0, eta }
+    };
+    let e = Environment {
+        name: "uniform".into(),
+        radiance: Radiance::Constant(Vec3::ONE),
+        scale: 1.0,
+        to_world: Mat3::IDENTITY,
+        samples: 256,
+    };
+    let centre = |model: Model| -> [f64; 3] {
+        let scene = SceneSettings {
+            mesh: Some("slab".into()),
+            scale: 2.0,
+            eye: Some(Vec3::new(0.0, 4.0, 0.0)),
+            target: Some(Vec3::ZERO),
+            up: Vec3::Z,
+            fov: 1.0,
+            ..Default::default()
+        };
+        let mut scene = scene.build().unwrap();
+        scene.lights = e.lights().unwrap();
+        let material = Material::custom([1.0, 0.5, 2.0], [2.0, 3.0, 1.0], [0.0; 3], eta).unwrap();
+        let mut s = RenderSettings::new(scene, material);
+        s.desc.integration.model = model;
+        s.desc.specular = false;
+        s.world.objects[0].samples = Some(80_000);
+        (s.desc.width, s.desc.height) = (8, 8);
+        let img = render_hdr(&s);
+        let p = img.pixels[(4 * img.width + 4) as usize];
+        [p[0] as f64, p[1] as f64, p[2] as f64]
+    };
+    let ft0 = fresnel::transmittance(eta, 1.0);
+    // cos θ nodes (midpoint rule in μ).
+    let nodes = 24;
+    let mus: Vec<f64> = (0..nodes).map(|i| (i as f64 + 0.5) / nodes as f64).collect();
+    let irradiance: f64 = mus.iter().map(|&mu| 2.0 * PI * fresnel::transmittance(eta, mu) * mu / nodes as f64).sum();
+    let classical = centre(Model::Dipole);
+    let directional = centre(Model::Directional);
+    for ch in 0..3 {
+        let c = medium(ch).constants(Diffusion::Classical);
+        let expected = ft0 * irradiance * dipole::total_rd(c.alpha_reduced, c.a_dipole) / PI;
+        println!(
+            "uniform environment, classical dipole, channel {ch}: {:.6} vs Ft(0) E Rd/π = {expected:.6}",
+            classical[ch]
+        );
+        assert!(
+            (classical[ch] / expected - 1.0).abs() <= 0.02,
+            "classical channel {ch}: {} vs {expected}",
+            classical[ch]
+        );
+        // P(μ): ∫Sd dA over the plane y = 0 for light from (sin θ, cos θ, 0), exit at the origin.
+        let plane = |mu: f64| {
+            let toward = DVec3::new((1.0 - mu * mu).max(0.0).sqrt(), mu, 0.0);
+            let (radii, angles) = (1500, 96);
+            let (lo, hi) = (1e-6f64.ln(), (40.0 / c.sigma_tr).ln());
+            let h = (hi - lo) / radii as f64;
+            let mut sum = 0.0;
+            for i in 0..radii {
+                let r = (lo + (i as f64 + 0.5) * h).exp();
+                let mut ring = 0.0;
+                for k in 0..angles {
+                    let phi = (k as f64 + 0.5) * std::f64::consts::TAU / angles as f64;
+                    let xi = DVec3::new(r * phi.cos(), 0.0, r * phi.sin());
+                    ring += dirpole::sd(&c, xi, DVec3::Y, toward, DVec3::ZERO, DVec3::Y);
+                }
+                sum += ring / angles as f64 * std::f64::consts::TAU * r * r * h;
+            }
+            sum
+        };
+        let expected: f64 = ft0
+            * mus
+                .iter()
+                .map(|&mu| 2.0 * PI * fresnel::transmittance(eta, mu) * mu * plane(mu) / nodes as f64)
+                .sum::<f64>();
+        // The same over the 256 lights themselves (their directions and irradiances).
+        let over_lights: f64 = e
+            .lights()
+            .unwrap()
+            .iter()
+            .map(|l| {
+                let Light::Directional { toward, irradiance } = *l else { unreachable!() };
+                let mu = toward.y as f64;
+                if mu <= 0.0 {
+                    0.0
+                } else {
+                    ft0 * irradiance.x as f64 * mu * fresnel::transmittance(eta, mu) * plane(mu)
+                }
+            })
+            .sum();
+        println!("  over the 256 lights: {over_lights:.6}");
+        println!(
+            "uniform environment, directional dipole, channel {ch}: {:.6} vs Ft(0) 2π∫Ft μ P dμ = {expected:.6}",
+            directional[ch]
+        );
+        assert!(
+            (directional[ch] / over_lights - 1.0).abs() <= 0.05,
+            "directional channel {ch}: {} vs {over_lights}",
+            directional[ch]
+        );
+        assert!(
+            (over_lights / expected - 1.0).abs() <= 0.005,
+            "channel {ch}: 256 directions {over_lights} vs {expected}"
+        );
+    }
+}
