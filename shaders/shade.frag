@@ -50,8 +50,9 @@ layout(binding = 11) uniform usamplerBuffer tile_entries;
 // The model's Sd per channel, tabulated (bssrdf.glsl): the classical dipole's or beam diffusion's.
 layout(binding = 12) uniform usamplerBuffer dipole_table;
 layout(std140, binding = 13) uniform Frame { FrameParams frame_params; };
-// PointFlux (sorted) as texels.
+// PointFlux and PointSpread (sorted) as texels.
 layout(binding = 14) uniform usamplerBuffer point_flux;
+layout(binding = 15) uniform usamplerBuffer point_spread;
 vec4 dipole_header; // its texel 0, read once per pixel
 
 const uint STACK_SIZE = 96u;
@@ -83,7 +84,8 @@ vec3 source(vec3 xi, vec3 ni, vec3 wi, vec3 power, vec3 xo, vec3 no) {
 // Every light's flux from xi at once: `power` (irradiance × scene-unit area) per channel, and
 // `incident` (PointFlux's sums times the area): the power-weighted sum of the refracted
 // directions, at the source's normal ni, is -(Σωi - (Σωi·ni)ni)/η - ni Σcos θt.
-vec3 merged_source(vec3 xi, vec3 ni, vec3 power, vec4 incident[3], vec3 xo, vec3 no) {
+// `dw` moves every channel's mean refracted direction (a sigma direction, see PointSpread).
+vec3 merged_source(vec3 xi, vec3 ni, vec3 power, vec4 incident[3], vec3 dw, vec3 xo, vec3 no) {
     float s = object_params.mm_per_unit;
     vec3 sd;
     if (MODEL == MODEL_DIRECTIONAL) {
@@ -94,7 +96,7 @@ vec3 merged_source(vec3 xi, vec3 ni, vec3 power, vec4 incident[3], vec3 xo, vec3
         vec3 w[3];
         for (uint c = 0u; c < 3u; ++c) {
             vec3 t = incident[c].xyz - dot(incident[c].xyz, ni) * ni;
-            w[c] = power[c] > 0.0 ? (-t * inv_eta - ni * incident[c].w) / power[c] : vec3(0.0);
+            w[c] = power[c] > 0.0 ? (-t * inv_eta - ni * incident[c].w) / power[c] + dw : vec3(0.0);
         }
         DirpoleGeometry g = dirpole_geometry_refracted(xi_mm, ni, w[0], xo_mm, no);
         sd.x = dirpole_channel_sd(object_params.channels[0], g, xi_mm, xo_mm, no);
@@ -123,6 +125,24 @@ void point_source(uint index, out vec3 xi, out vec3 power, out vec4 incident[3])
     xi = position_area.xyz;
     power = texel_float(points, index * POINT_TEXELS + 2u).xyz * position_area.w;
     for (uint c = 0u; c < 3u; ++c) incident[c] = texel_float(point_flux, index * POINT_FLUX_TEXELS + c) * position_area.w;
+}
+
+// Point `index` evaluated on its own (the near field): its mean refracted directions, or, where
+// the lights' directions spread (PointSpread), four sigma directions of a quarter power each.
+// Returns the evaluations made.
+vec3 point_evaluated(uint index, vec3 xi, vec3 ni, vec3 power, vec4 incident[3], vec3 xo, vec3 no, out uint made) {
+    vec3 a0 = texel_float(point_spread, index * POINT_SPREAD_TEXELS).xyz;
+    vec3 a1 = texel_float(point_spread, index * POINT_SPREAD_TEXELS + 1u).xyz;
+    if (a0 == vec3(0.0) && a1 == vec3(0.0)) {
+        made = 1u;
+        return merged_source(xi, ni, power, incident, vec3(0.0), xo, no);
+    }
+    made = 4u;
+    vec3 q = 0.25 * power;
+    vec4 iq[3];
+    for (uint c = 0u; c < 3u; ++c) iq[c] = 0.25 * incident[c];
+    return merged_source(xi, ni, q, iq, a0, xo, no) + merged_source(xi, ni, q, iq, -a0, xo, no)
+         + merged_source(xi, ni, q, iq, a1, xo, no) + merged_source(xi, ni, q, iq, -a1, xo, no);
 }
 
 // The two sources of node `index` used whole: sigma points center ± offset, each with half the
@@ -198,9 +218,10 @@ void main() {
             vec4 incident[3];
             point_source(index, xi, power, incident);
             if (power == vec3(0.0)) continue;
-            ++evaluations;
             vec3 ni = texel_float(points, index * POINT_TEXELS + 1u).xyz;
-            sum += merged_source(xi, ni, power, incident, xo, no);
+            uint made;
+            sum += point_evaluated(index, xi, ni, power, incident, xo, no, made);
+            evaluations += made;
         }
         evaluated += tile.y;
         entry += tile.y;
@@ -213,8 +234,8 @@ void main() {
             node_sigma(index, ni, xo, center, offset, power, incident);
             if (power == vec3(0.0)) continue;
             evaluations += 2u;
-            sum += merged_source(center + offset, ni, power, incident, xo, no)
-                 + merged_source(center - offset, ni, power, incident, xo, no);
+            sum += merged_source(center + offset, ni, power, incident, vec3(0.0), xo, no)
+                 + merged_source(center - offset, ni, power, incident, vec3(0.0), xo, no);
         }
         visits += tile.z;
         entry += tile.z;
@@ -286,8 +307,14 @@ void main() {
                     xi += evaluation != 0u ? -offset : offset;
                 }
                 if (power == vec3(0.0)) continue;
-                ++evaluations;
-                sum += merged_source(xi, ni, power, incident, xo, no);
+                if (is_point) {
+                    uint made;
+                    sum += point_evaluated(index, xi, ni, power, incident, xo, no, made);
+                    evaluations += made;
+                } else {
+                    ++evaluations;
+                    sum += merged_source(xi, ni, power, incident, vec3(0.0), xo, no);
+                }
             }
         }
     }

@@ -59,6 +59,7 @@ macro_rules! shade_inputs {
             point_lights: &o.hierarchy.sorted_point_lights,
             point_flux: &o.hierarchy.sorted_point_flux,
             node_flux: &o.hierarchy.node_flux,
+            point_spread: &o.hierarchy.sorted_point_spread,
             tile_headers: &lists.headers,
             tile_entries: &lists.entries,
             sd_table: &o.sd_table,
@@ -448,7 +449,7 @@ impl HierarchyPasses {
         // Per point: the light entering the surface from every light, merged (and per light for
         // brute force).
         rec.scope("irradiance", |rec| {
-            let (points, flux, lights) = (&h.points, &h.point_flux, &shadows.lights);
+            let (points, flux, lights) = (&h.points, (&h.point_flux, &h.point_spread), &shadows.lights);
             let records = (&h.point_lights, h.per_light_count > 0);
             self.irradiance.record(rec, points, records, flux, n, lights, &shadows.shadow_map, &shadows.shadow_sampler)
         })?;

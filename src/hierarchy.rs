@@ -73,8 +73,18 @@ pub fn decode_oct(e: u32) -> Vec3 {
 /// a point parent and about one node (with its parent and arrival counter), the merged light
 /// record twice (unsorted, sorted) and about one node's; and, for brute force only, per light
 /// the point's own record twice.
-const BYTES_PER_POINT: u64 =
-    64 * 2 + 8 * 2 + 4 * 2 + 4 + 64 + 4 + 4 + 4 + 2 * POINT_FLUX_BYTES + std::mem::size_of::<NodeFlux>() as u64;
+const BYTES_PER_POINT: u64 = 64 * 2
+    + 8 * 2
+    + 4 * 2
+    + 4
+    + 64
+    + 4
+    + 4
+    + 4
+    + 2 * POINT_FLUX_BYTES
+    + std::mem::size_of::<NodeFlux>() as u64
+    + 2 * POINT_SPREAD_BYTES;
+const POINT_SPREAD_BYTES: u64 = 32;
 const BYTES_PER_POINT_AND_LIGHT: u64 = 16 * 2;
 const POINT_FLUX_BYTES: u64 = std::mem::size_of::<PointFlux>() as u64;
 
@@ -137,6 +147,9 @@ pub struct Hierarchy {
     pub sorted_point_flux: Buffer,
     /// Every light's merged record of each node.
     pub node_flux: Buffer,
+    /// How the lights' directions spread at each point (PointSpread), unsorted then sorted.
+    pub(crate) point_spread: Buffer,
+    pub sorted_point_spread: Buffer,
     pub node_parent: Buffer,
     pub point_parent: Buffer,
     pub arrivals: Buffer,
@@ -194,6 +207,8 @@ impl Hierarchy {
             point_flux: storage("point flux records", n64 * POINT_FLUX_BYTES)?,
             sorted_point_flux: texels("sorted point flux records", n64 * POINT_FLUX_BYTES)?,
             node_flux: texels("node flux records", (n64 - 1) * std::mem::size_of::<NodeFlux>() as u64)?,
+            point_spread: storage("point spread records", n64 * POINT_SPREAD_BYTES)?,
+            sorted_point_spread: texels("sorted point spread records", n64 * POINT_SPREAD_BYTES)?,
             node_parent: storage("node parents", (n64 - 1) * 4)?,
             point_parent: storage("point parents", n64 * 4)?,
             arrivals: storage("node arrival counters", (n64 - 1) * 4)?,
@@ -251,6 +266,8 @@ impl Hierarchy {
             per_light_count: self.per_light_count,
             point_flux: &self.point_flux,
             sorted_point_flux: &self.sorted_point_flux,
+            point_spread: &self.point_spread,
+            sorted_point_spread: &self.sorted_point_spread,
         }
     }
 

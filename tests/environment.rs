@@ -119,9 +119,9 @@ fn relative_rmse(a: &[[f32; 4]], reference: &[[f32; 4]]) -> f64 {
 }
 
 /// A sky with a sun on a sphere, validation on: K = 16, 64, 256 directions converge toward 1024
-/// (measured, lavapipe: 25%, 16%, 7.7% relative RMSE; slow, as the shadow maps' resolution falls
-/// with K, 512² at 256 and 256² at 1024, and merged records of lights from every side are their
-/// worst case). The background shows the sky (alpha 1) in every render.
+/// (measured, lavapipe: 27%, 21%, 5.7% relative RMSE; slowly at first: the sun's disk is a few
+/// texels that few directions cannot place well, and the shadow maps' resolution falls with K,
+/// 512² at 256 and 256² at 1024). The background shows the sky (alpha 1) in every render.
 #[test]
 fn sky_renders_converge_in_the_number_of_directions() {
     let reference = render_hdr(&sky_settings(1024));
@@ -179,15 +179,15 @@ fn bad_environments_are_refused_by_name() {
 
 /// A thick slab (8 × 8 × 2 mm, σa = 1, 0.5, 2 and σs = 2, 3, 1 per mm, η = 1.3, as in
 /// tests/subsurface.rs) under a uniform environment L = 1 in 256 directions, seen from straight
-/// above: the centre pixel against the closed forms of a half-space lit from the whole upper
+/// above: the mean of a central patch against the closed forms of a half-space lit from the whole upper
 /// hemisphere. Classical dipole: Ft(0) · E · Rd/π with E = 2π∫Ft(μ)μ dμ. Directional dipole:
 /// Ft(0) · 2π∫ Ft(μ) μ P(μ) dμ, P(μ) its f64 plane integral for light at cos θ = μ (by symmetry
-/// the same for every azimuth). The classical dipole within 2%, as the single-light slab tests
-/// (sampling, the slab's finite size and its lit bottom; measured +0.3%, +0.7%). The directional
-/// dipole is held to 5%, a known shortfall and not the goal: measured 2.8–4.1% high, of which the
-/// 256 directions account for 0.15% (the same sum over the lights themselves, printed) and the
-/// rest is the merged records' (lights over the whole hemisphere, their worst case: the real
-/// source's distance dr is not affine in the refracted direction, see tests/lights.rs).
+/// the same for every azimuth). Both within 2% as the single-light slab tests (sampling, the
+/// slab's finite size), plus 1% for the directional dipole's merged records of lights over the
+/// whole hemisphere (with the tree). Measured: classical +0.06%, +0.55%, −0.14%; directional
+/// −1.6%, −0.55%, −2.4% against the same sum over the 256 lights (which is within 0.15% of the
+/// integral). A single pixel varies with where the points fall (±5% for the directional
+/// dipole's sharp near field at 80k points): a patch's mean is compared.
 #[test]
 fn thick_slab_under_a_uniform_environment_equals_the_closed_forms() {
     use glam::DVec3;
@@ -211,7 +211,9 @@ fn thick_slab_under_a_uniform_environment_equals_the_closed_forms() {
             eye: Some(Vec3::new(0.0, 4.0, 0.0)),
             target: Some(Vec3::ZERO),
             up: Vec3::Z,
-            fov: 1.0,
+            // A patch 1.4 mm across: one pixel's sum over points near it varies with where the
+            // points fell (tests/subsurface.rs's slab_patch_mean); the patch's mean does not.
+            fov: 10.0,
             ..Default::default()
         };
         let mut scene = scene.build().unwrap();
@@ -223,8 +225,12 @@ fn thick_slab_under_a_uniform_environment_equals_the_closed_forms() {
         s.world.objects[0].samples = Some(80_000);
         (s.desc.width, s.desc.height) = (8, 8);
         let img = render_hdr(&s);
-        let p = img.pixels[(4 * img.width + 4) as usize];
-        [p[0] as f64, p[1] as f64, p[2] as f64]
+        let mut sum = [0.0f64; 3];
+        for p in &img.pixels {
+            assert_eq!(p[3], 1.0);
+            (0..3).for_each(|c| sum[c] += p[c] as f64);
+        }
+        sum.map(|v| v / img.pixels.len() as f64)
     };
     let ft0 = fresnel::transmittance(eta, 1.0);
     // cos θ nodes (midpoint rule in μ).
@@ -290,7 +296,7 @@ fn thick_slab_under_a_uniform_environment_equals_the_closed_forms() {
             directional[ch]
         );
         assert!(
-            (directional[ch] / over_lights - 1.0).abs() <= 0.05,
+            (directional[ch] / over_lights - 1.0).abs() <= 0.03,
             "directional channel {ch}: {} vs {over_lights}",
             directional[ch]
         );

@@ -57,11 +57,11 @@ fn settings(mesh: &str, lights: Vec<Light>, model: Model, brute_force: bool) -> 
 /// front-lit, a back-lit and a grazing-lit sphere with 2, 8 and 64 lights within 30° of the main
 /// direction (the camera looks along −z: front is +z, back −z, grazing +x). Two errors are
 /// measured apart: the merging's own (every point evaluated singly, ε = 0, against brute
-/// force) and the tree's at the default ε, which adds the tree's own error (that of one light
-/// alone, measured beside it). The goal is 0.5%; the merged records do not reach it
-/// everywhere on Skin1 at these 3000 points (measured, lavapipe: merging alone 0.34% with 2
-/// front lights, 0.91% with 8; the near field's real-source distance dr is not affine in the
-/// refracted direction). These bounds guard what was measured; the README gives the table.
+/// force) and the tree's at the default ε. The bound is 0.5% for both. Measured
+/// (lavapipe): merging alone 0.013–0.070%, the tree 0.17–0.47% (one light's own tree error
+/// 0.18–0.85%). With the mean refracted direction alone (no sigma directions, PointSpread) the
+/// merging alone was 0.08–1.03%: the near field's real-source distance dr is not affine in the
+/// refracted direction.
 #[test]
 fn merged_lights_match_exact_brute_force() {
     for (case, axis) in [
@@ -88,8 +88,8 @@ fn merged_lights_match_exact_brute_force() {
                 error * 100.0,
                 tree_error * 100.0
             );
-            assert!(merging <= 1.5e-2, "{case}, {k} lights: merging {merging}");
-            assert!(error <= tree_error + 1.5e-2, "{case}, {k} lights: tree {error}, one light's {tree_error}");
+            assert!(merging <= 5e-3, "{case}, {k} lights: merging {merging}");
+            assert!(error <= 5e-3, "{case}, {k} lights: tree {error} (one light's {tree_error})");
         }
     }
 }

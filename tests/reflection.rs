@@ -17,7 +17,7 @@ fn shade_frag_declares_its_buffers_texels_and_images() {
     assert_eq!(r.stage, Stage::Fragment);
     let numbers: Vec<u32> = r.bindings.iter().map(|b| b.binding).collect();
     assert_eq!(numbers, (0..numbers.len() as u32).collect::<Vec<_>>(), "bindings 0..n in order");
-    assert_eq!(r.bindings.len(), 15, "{:?}", r.bindings);
+    assert_eq!(r.bindings.len(), 16, "{:?}", r.bindings);
     for b in &r.bindings {
         assert_eq!((b.set, b.count), (0, 1), "{b:?}");
         let expected = match b.binding {

@@ -10,6 +10,8 @@ layout(std430, binding = 3) readonly buffer PointLights { PointLight point_light
 layout(std430, binding = 4) writeonly buffer SortedPointLights { PointLight sorted_point_lights[]; };
 layout(std430, binding = 5) readonly buffer PointFluxes { PointFlux point_flux[]; };
 layout(std430, binding = 6) writeonly buffer SortedPointFluxes { PointFlux sorted_point_flux[]; };
+layout(std430, binding = 7) readonly buffer PointSpreads { PointSpread point_spread[]; };
+layout(std430, binding = 8) writeonly buffer SortedPointSpreads { PointSpread sorted_point_spread[]; };
 // per_light_count: lights with their own records (0 unless brute force).
 layout(push_constant) uniform GatherConstants { uint point_count; uint per_light_count; } pc;
 void main() {
@@ -18,6 +20,7 @@ void main() {
     uint from = order[i];
     sorted_points[i] = points[from];
     sorted_point_flux[i] = point_flux[from];
+    sorted_point_spread[i] = point_spread[from];
     for (uint k = 0u; k < pc.per_light_count; ++k)
         sorted_point_lights[i * pc.per_light_count + k] = point_lights[from * pc.per_light_count + k];
 }

@@ -13,7 +13,44 @@ layout(std430, binding = 0) buffer Points { SurfacePoint points[]; };
 layout(binding = 2) uniform sampler2DArrayShadow shadow_map;
 layout(std430, binding = 3) writeonly buffer PointLights { PointLight point_lights[]; };
 layout(std430, binding = 4) writeonly buffer PointFluxes { PointFlux point_flux[]; };
+layout(std430, binding = 5) writeonly buffer PointSpreads { PointSpread point_spread[]; };
 layout(push_constant) uniform IrradianceConstants { uint point_count; uint per_light_records; } pc;
+
+// The two sigma axes of the directions' covariance (PointSpread): Jacobi rotations of the 3×3
+// symmetric matrix (a few sweeps converge it to float precision), its two largest eigenpairs.
+PointSpread spread_of(float weight, vec3 first, mat3 second) {
+    PointSpread s;
+    s.axis[0] = s.axis[1] = vec4(0.0);
+    if (weight <= 0.0) return s;
+    vec3 mean = first / weight;
+    mat3 a = second / weight - outerProduct(mean, mean);
+    mat3 v = mat3(1.0);
+    for (int sweep = 0; sweep < 5; ++sweep) {
+        for (int k = 0; k < 3; ++k) {
+            int p = k == 2 ? 1 : 0, q = k == 0 ? 1 : 2;
+            float apq = a[q][p];
+            if (abs(apq) < 1e-12) continue;
+            float theta = 0.5 * (a[q][q] - a[p][p]) / apq;
+            float t = sign(theta) / (abs(theta) + sqrt(theta * theta + 1.0));
+            if (theta == 0.0) t = 1.0;
+            float c = inversesqrt(t * t + 1.0), sn = t * c;
+            mat3 r = mat3(1.0);
+            r[p][p] = c; r[q][q] = c; r[q][p] = sn; r[p][q] = -sn;
+            a = transpose(r) * a * r;
+            v = v * r;
+        }
+    }
+    vec3 l = max(vec3(a[0][0], a[1][1], a[2][2]), vec3(0.0));
+    // The two largest.
+    int smallest = l.x <= l.y && l.x <= l.z ? 0 : (l.y <= l.z ? 1 : 2);
+    int j0 = smallest == 0 ? 1 : 0, j1 = smallest == 2 ? 1 : 2;
+    s.axis[0] = vec4(v[j0] * sqrt(2.0 * l[j0]), 0.0);
+    s.axis[1] = vec4(v[j1] * sqrt(2.0 * l[j1]), 0.0);
+    // One light (or lights of one direction): no spread, one evaluation.
+    if (l[j0] < 1e-10) s.axis[0] = vec4(0.0);
+    if (l[j1] < 1e-10) s.axis[1] = vec4(0.0);
+    return s;
+}
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
@@ -23,6 +60,10 @@ void main() {
     vec3 weighted_dir = vec3(0.0);
     PointFlux flux;
     flux.incident[0] = flux.incident[1] = flux.incident[2] = vec4(0.0);
+    // Luminance-weighted first and second moments of the refracted directions.
+    float weight = 0.0;
+    vec3 first = vec3(0.0);
+    mat3 second = mat3(0.0);
     for (uint k = 0u; k < light_set.light_count; ++k) {
         GpuLight light = light_of(k);
         vec3 toward;
@@ -45,10 +86,16 @@ void main() {
         float cos_i = dot(wi, p.normal);
         float cos_t = sqrt(max(1.0 - (1.0 - cos_i * cos_i) / (light_set.eta * light_set.eta), 0.0));
         for (uint c = 0u; c < 3u; ++c) flux.incident[c] += e[c] * vec4(wi, cos_t);
+        float y = dot(e, vec3(0.2126, 0.7152, 0.0722));
+        vec3 w12 = refract_in(wi, p.normal, light_set.eta);
+        weight += y;
+        first += y * w12;
+        second += y * outerProduct(w12, w12);
         irradiance += e;
         weighted_dir += dot(e, vec3(0.2126, 0.7152, 0.0722)) * toward;
     }
     points[i].irradiance = irradiance;
     points[i].light_dir = dot(weighted_dir, weighted_dir) > 0.0 ? normalize(weighted_dir) : vec3(0.0);
     point_flux[i] = flux;
+    point_spread[i] = spread_of(weight, first, second);
 }

@@ -38,6 +38,16 @@ struct PointFlux {
     vec4 incident[3];
 };
 
+// How the lights' refracted directions spread about their mean at one point (32 bytes): two
+// sigma axes a_j = sqrt(2 λ_j) e_j of the luminance-weighted covariance of ω12 (its two largest
+// eigenvalues λ_j, eigenvectors e_j), zero for one light. A point evaluated on its own (the near
+// field) is then four sources ω̄ ± a_1, ω̄ ± a_2 of a quarter of its power each: they keep the
+// mean and the covariance, so the source's curvature in ω12 (through dr) is taken into account
+// to second order. Far sources (nodes) use the mean alone: there the curvature does not matter.
+struct PointSpread {
+    vec4 axis[2];
+};
+
 // A node of the Karras (HPG 2012) binary radix tree over the Morton-sorted points (64 bytes).
 // Children with LEAF_BIT (gpu_constants.glsl) set are point indices (in sorted order), else node indices.
 struct TreeNode {
@@ -73,6 +83,7 @@ const uint POINT_TEXELS = 4u;
 const uint NODE_TEXELS = 4u;
 const uint POINT_FLUX_TEXELS = 3u;
 const uint NODE_FLUX_TEXELS = 4u;
+const uint POINT_SPREAD_TEXELS = 2u;
 uvec4 texel(usamplerBuffer records, uint index) { return texelFetch(records, int(index)); }
 vec4 texel_float(usamplerBuffer records, uint index) { return uintBitsToFloat(texelFetch(records, int(index))); }
 

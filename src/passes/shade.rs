@@ -51,6 +51,7 @@ pub struct ShadeInputs<'a> {
     pub point_lights: &'a Buffer,
     pub point_flux: &'a Buffer,
     pub node_flux: &'a Buffer,
+    pub point_spread: &'a Buffer,
     /// The object's Sd table (`gpu::SdTable`: the classical dipole's or beam diffusion's).
     pub sd_table: &'a Buffer,
     /// The tile-cut pass's lists (headers and entries).
@@ -253,6 +254,7 @@ impl ShadePass {
             Bind::Texels(inputs.sd_table),
             Bind::Uniform(inputs.frame_params),
             Bind::Texels(inputs.point_flux),
+            Bind::Texels(inputs.point_spread),
         ];
         let mut c = *constants;
         c.point_range = glam::UVec4::new(unit.first_point, unit.point_count, unit.object, 0);

@@ -21,6 +21,9 @@ pub struct SortBuffers<'a> {
     /// Every light's merged record of each point.
     pub point_flux: &'a Buffer,
     pub sorted_point_flux: &'a Buffer,
+    /// How the lights' directions spread at each point.
+    pub point_spread: &'a Buffer,
+    pub sorted_point_spread: &'a Buffer,
 }
 
 pub struct SortPass {
@@ -92,6 +95,8 @@ impl SortPass {
                 Bind::Write(b.sorted_point_lights),
                 Bind::Read(b.point_flux),
                 Bind::Write(b.sorted_point_flux),
+                Bind::Read(b.point_spread),
+                Bind::Write(b.sorted_point_spread),
             ],
             bytemuck::bytes_of(&[n, b.per_light_count]),
             [n.div_ceil(64), 1, 1],
