@@ -56,6 +56,9 @@ layout(binding = 15) uniform usamplerBuffer point_spread;
 vec4 dipole_header; // its texel 0, read once per pixel
 
 const uint STACK_SIZE = 96u;
+// Points nearer than this many diffusion lengths (1/σtr) of the farthest-reaching channel are
+// evaluated in sigma directions (PointSpread).
+const float SIGMA_DIRECTIONS_REACH = 2.0;
 // Stack entries: a point or node index (below 2^24, with LEAF_BIT for points) and the number of
 // its next evaluation plus one (a node's second sigma point).
 const uint EVALUATION_SHIFT = 24u;
@@ -133,7 +136,12 @@ void point_source(uint index, out vec3 xi, out vec3 power, out vec4 incident[3])
 vec3 point_evaluated(uint index, vec3 xi, vec3 ni, vec3 power, vec4 incident[3], vec3 xo, vec3 no, out uint made) {
     vec3 a0 = texel_float(point_spread, index * POINT_SPREAD_TEXELS).xyz;
     vec3 a1 = texel_float(point_spread, index * POINT_SPREAD_TEXELS + 1u).xyz;
-    if (a0 == vec3(0.0) && a1 == vec3(0.0)) {
+    // Beyond two diffusion lengths of the farthest-reaching channel the source's curvature in ω12
+    // no longer shows (measured: the sigma directions changed nothing there).
+    float reach = SIGMA_DIRECTIONS_REACH / min(min(object_params.channels[0].sigma_tr, object_params.channels[1].sigma_tr),
+                                               object_params.channels[2].sigma_tr);
+    bool near = length(xo - xi) * object_params.mm_per_unit < reach;
+    if ((a0 == vec3(0.0) && a1 == vec3(0.0)) || !near) {
         made = 1u;
         return merged_source(xi, ni, power, incident, vec3(0.0), xo, no);
     }

@@ -47,8 +47,9 @@ PointSpread spread_of(float weight, vec3 first, mat3 second) {
     s.axis[0] = vec4(v[j0] * sqrt(2.0 * l[j0]), 0.0);
     s.axis[1] = vec4(v[j1] * sqrt(2.0 * l[j1]), 0.0);
     // One light (or lights of one direction): no spread, one evaluation.
-    if (l[j0] < 1e-10) s.axis[0] = vec4(0.0);
-    if (l[j1] < 1e-10) s.axis[1] = vec4(0.0);
+    // (float rounding leaves about 1e-8 of one direction's: a spread below 1e-3 rad is none.)
+    if (l[j0] < 1e-6) s.axis[0] = vec4(0.0);
+    if (l[j1] < 1e-6) s.axis[1] = vec4(0.0);
     return s;
 }
 
