@@ -10,6 +10,7 @@ use common::{render_hdr, stderr, translucent};
 use glam::{Mat3, Vec3};
 use translucent::environment::{self, Environment, Layout, Radiance};
 use translucent::materials::Material;
+use translucent::output::relative_rmse;
 use translucent::physics::fresnel;
 use translucent::scene::Light;
 use translucent::settings::{RenderSettings, SceneSettings};
@@ -107,17 +108,6 @@ fn sky_settings(samples: u32) -> RenderSettings {
     s
 }
 
-fn relative_rmse(a: &[[f32; 4]], reference: &[[f32; 4]]) -> f64 {
-    let (mut err, mut norm) = (0.0f64, 0.0f64);
-    for (p, q) in a.iter().zip(reference).filter(|(_, q)| q[3] > 0.0) {
-        for c in 0..3 {
-            err += (p[c] as f64 - q[c] as f64).powi(2);
-            norm += (q[c] as f64).powi(2);
-        }
-    }
-    (err / norm).sqrt()
-}
-
 /// A sky with a sun on a sphere, validation on: K = 16, 64, 256 directions converge toward 1024
 /// (measured, lavapipe: 27%, 21%, 5.7% relative RMSE; slowly at first: the sun's disk is a few
 /// texels that few directions cannot place well, and the shadow maps' resolution falls with K,
@@ -191,7 +181,7 @@ fn bad_environments_are_refused_by_name() {
 #[test]
 fn thick_slab_under_a_uniform_environment_equals_the_closed_forms() {
     use glam::DVec3;
-    use translucent::physics::{dipole, dirpole, Diffusion, Medium, Model};
+    use translucent::physics::{dipole, Diffusion, Medium, Model};
     let eta = 1.3;
     let medium = |ch: usize| {
         let (sigma_a, sigma_s) = [(1.0, 2.0), (0.5, 3.0), (2.0, 1.0)][ch];
@@ -254,21 +244,7 @@ fn thick_slab_under_a_uniform_environment_equals_the_closed_forms() {
         // P(μ): ∫Sd dA over the plane y = 0 for light from (sin θ, cos θ, 0), exit at the origin.
         let plane = |mu: f64| {
             let toward = DVec3::new((1.0 - mu * mu).max(0.0).sqrt(), mu, 0.0);
-            let (radii, angles) = (1500, 96);
-            let (lo, hi) = (1e-6f64.ln(), (40.0 / c.sigma_tr).ln());
-            let h = (hi - lo) / radii as f64;
-            let mut sum = 0.0;
-            for i in 0..radii {
-                let r = (lo + (i as f64 + 0.5) * h).exp();
-                let mut ring = 0.0;
-                for k in 0..angles {
-                    let phi = (k as f64 + 0.5) * std::f64::consts::TAU / angles as f64;
-                    let xi = DVec3::new(r * phi.cos(), 0.0, r * phi.sin());
-                    ring += dirpole::sd(&c, xi, DVec3::Y, toward, DVec3::ZERO, DVec3::Y);
-                }
-                sum += ring / angles as f64 * std::f64::consts::TAU * r * r * h;
-            }
-            sum
+            common::dirpole_plane_integral(&c, toward, (1500, 96))
         };
         let expected: f64 = ft0
             * mus

@@ -7,21 +7,10 @@ mod common;
 use common::render_hdr;
 use glam::Vec3;
 use translucent::materials::Material;
+use translucent::output::relative_rmse;
 use translucent::physics::Model;
 use translucent::scene::Light;
 use translucent::settings::{RenderSettings, SceneSettings};
-
-/// Relative RMSE over the pixels `reference` covers.
-fn relative_rmse(a: &[[f32; 4]], reference: &[[f32; 4]]) -> f64 {
-    let (mut err, mut norm) = (0.0f64, 0.0f64);
-    for (p, q) in a.iter().zip(reference).filter(|(_, q)| q[3] > 0.0) {
-        for c in 0..3 {
-            err += (p[c] as f64 - q[c] as f64).powi(2);
-            norm += (q[c] as f64).powi(2);
-        }
-    }
-    (err / norm).sqrt()
-}
 
 /// `k` directional lights within `cone_deg` of `axis`, of different strengths and colours
 /// (a small deterministic generator: the same lights on every run), total irradiance about 1.

@@ -154,26 +154,8 @@ fn thick_slab_classical_dipole_equals_the_closed_form() {
 /// ∫Sd dA over the plane y = 0 (normal +y) for light arriving from `toward` at the origin, exit
 /// at the origin: polar grid, log-spaced radii.
 fn dirpole_plane_integral(toward: glam::DVec3, channel: usize) -> f64 {
-    use glam::DVec3;
-    use translucent::physics::{dirpole, Diffusion};
-    let c = slab_medium(channel).constants(Diffusion::Classical);
-    let n = DVec3::Y;
-    let (radii, angles) = (4000, 256);
-    let (lo, hi) = (1e-6f64.ln(), (40.0 / c.sigma_tr).ln());
-    let h = (hi - lo) / radii as f64;
-    let mut sum = 0.0;
-    for i in 0..radii {
-        let r = (lo + (i as f64 + 0.5) * h).exp();
-        let mut ring = 0.0;
-        for k in 0..angles {
-            let phi = (k as f64 + 0.5) * std::f64::consts::TAU / angles as f64;
-            // Entry point xi around the exit point xo = 0.
-            let xi = DVec3::new(r * phi.cos(), 0.0, r * phi.sin());
-            ring += dirpole::sd(&c, xi, n, toward, DVec3::ZERO, n);
-        }
-        sum += ring / angles as f64 * std::f64::consts::TAU * r * r * h;
-    }
-    sum
+    let c = slab_medium(channel).constants(translucent::physics::Diffusion::Classical);
+    common::dirpole_plane_integral(&c, toward, (4000, 256))
 }
 
 #[test]

@@ -8,6 +8,7 @@ use glam::Vec3;
 use translucent::frame::Renderer;
 use translucent::frame_desc::{FrameDesc, Integration};
 use translucent::mesh::Mesh;
+use translucent::output::relative_rmse;
 use translucent::scene::{bounding_sphere, Camera, Light};
 use translucent::world::World;
 
@@ -54,17 +55,6 @@ fn tiles_leave_no_seams() {
             assert_eq!(differing, 0, "brute force {brute_force}: tiling {k} differs in {differing} pixels");
         }
     }
-}
-
-fn relative_rmse(a: &[[f32; 4]], reference: &[[f32; 4]]) -> f64 {
-    let (mut err, mut norm) = (0.0f64, 0.0f64);
-    for (p, q) in a.iter().zip(reference).filter(|(_, q)| q[3] > 0.0) {
-        for c in 0..3 {
-            err += (p[c] as f64 - q[c] as f64).powi(2);
-            norm += (q[c] as f64).powi(2);
-        }
-    }
-    (err / norm).sqrt()
 }
 
 /// The tile lists' two fall-backs: lists that start too small grow to what the frame needs and

@@ -145,3 +145,30 @@ pub fn random_queries(n: usize, seed: u64) -> Vec<Query> {
         })
         .collect()
 }
+
+/// ∫Sd dA of the directional dipole over the plane y = 0 (normal +y), light arriving from
+/// `toward`, exit at the origin: a polar grid of `radii` log-spaced radii (1e-6 mm to 40
+/// diffusion lengths) and `angles` angles, in f64.
+pub fn dirpole_plane_integral(
+    c: &translucent::physics::ChannelConstants,
+    toward: glam::DVec3,
+    (radii, angles): (usize, usize),
+) -> f64 {
+    use glam::DVec3;
+    let n = DVec3::Y;
+    let (lo, hi) = (1e-6f64.ln(), (40.0 / c.sigma_tr).ln());
+    let h = (hi - lo) / radii as f64;
+    let mut sum = 0.0;
+    for i in 0..radii {
+        let r = (lo + (i as f64 + 0.5) * h).exp();
+        let mut ring = 0.0;
+        for k in 0..angles {
+            let phi = (k as f64 + 0.5) * std::f64::consts::TAU / angles as f64;
+            // Entry point xi around the exit point xo = 0.
+            let xi = DVec3::new(r * phi.cos(), 0.0, r * phi.sin());
+            ring += translucent::physics::dirpole::sd(c, xi, n, toward, DVec3::ZERO, n);
+        }
+        sum += ring / angles as f64 * std::f64::consts::TAU * r * r * h;
+    }
+    sum
+}
