@@ -18,13 +18,13 @@ struct BssrdfQuery {
 
 layout(std430, binding = 0) readonly buffer Queries { BssrdfQuery queries[]; };
 layout(std430, binding = 1) writeonly buffer Results { float sd[]; };
-// Photon beam diffusion's Sd tables (gpu::SdTable), one per distinct medium, end to end; a
+// Photon beam diffusion's or the Monte Carlo table's Sd tables (gpu::SdTable), one per distinct medium, end to end; a
 // placeholder for the other models.
 layout(binding = 2) uniform usamplerBuffer tables;
 
 layout(push_constant) uniform EvalConstants {
     uint count;
-    uint model; // 0 directional dipole, 1 classical dipole, 2 photon beam diffusion
+    uint model; // 0 directional dipole, 1 classical dipole, 2 photon beam diffusion, 3 Monte Carlo table
 } pc;
 
 void main() {
@@ -34,7 +34,7 @@ void main() {
     float value;
     if (pc.model == MODEL_DIRECTIONAL) {
         value = dirpole_sd(q.channel, q.xi.xyz, q.ni.xyz, q.wi.xyz, q.xo.xyz, q.no.xyz);
-    } else if (pc.model == MODEL_PBD) {
+    } else if (pc.model == MODEL_PBD || pc.model == MODEL_MC) {
         // As the shade pass reads it.
         int base = int(q.table.x * DIPOLE_TABLE_SIZE);
         value = sd_table_at(tables, base, sd_table_header_at(tables, base), length(q.xo.xyz - q.xi.xyz)).x;

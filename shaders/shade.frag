@@ -23,7 +23,7 @@
 // The model, fixed per pipeline: llvmpipe runs both sides of a branch for every SIMD group, so a
 // model chosen at run time would cost both models' arithmetic (measured: the classical dipole
 // took 2.4x longer beside the directional one's dead code).
-layout(constant_id = 0) const uint MODEL = 0u; // 0 directional dipole, 1 classical dipole, 2 beam diffusion (1, 2: table)
+layout(constant_id = 0) const uint MODEL = 0u; // 0 directional dipole, 1 classical dipole, 2 beam diffusion, 3 Monte Carlo table (1-3: table)
 
 layout(location = 0) out vec4 radiance;
 
@@ -189,6 +189,28 @@ vec3 specular(vec3 xo, vec3 no, vec3 wo) {
     return sum;
 }
 
+// The pixel's own angle of incidence: the refracted cosine of its lights, weighted by the
+// luminance of the irradiance each brings in (shadowed, as irradiance.comp computes it); 1 (normal
+// incidence) where none reaches it. The Monte Carlo table's exit factor is read there.
+float own_cos_t(vec3 xo, vec3 no) {
+    float weight = 0.0, sum = 0.0;
+    float eta = object_params.channels[0].eta;
+    for (uint k = 0u; k < light_set.light_count; ++k) {
+        vec3 toward;
+        uint layer;
+        vec3 incident = light_at(light_of(k), xo, toward, layer);
+        float cos_i = dot(no, toward);
+        if (cos_i <= 0.0) continue;
+        vec4 clip = layer_matrix(layer) * vec4(xo + no * light_set.normal_offset, 1.0);
+        vec3 ndc = clip.xyz / clip.w;
+        float visibility = texture(shadow_map, vec4(ndc.xy * 0.5 + 0.5, float(layer), ndc.z));
+        float e = dot(incident, vec3(0.2126, 0.7152, 0.0722)) * cos_i * fresnel_transmittance(eta, cos_i) * visibility;
+        weight += e;
+        sum += e * sqrt(max(1.0 - (1.0 - cos_i * cos_i) / (eta * eta), 0.0));
+    }
+    return weight > 0.0 ? sum / weight : 1.0;
+}
+
 void main() {
     ivec2 pixel = ivec2(gl_FragCoord.xy);
     vec4 surface = imageLoad(surface_position, pixel);
@@ -343,6 +365,8 @@ void main() {
     }
     float cos_o = max(dot(no, wo), 0.0);
     vec3 lo = fresnel_transmittance(object_params.channels[0].eta, cos_o) * sum;
+    // The Monte Carlo table's exit distribution (the others' lobe is Ft alone).
+    if (MODEL == MODEL_MC) lo *= table_exit_factor(dipole_table, own_cos_t(xo, no), cos_o);
     // The lobe is added once: by the first of several brute-force draws.
     if (frame_params.specular != 0u && pc.point_range.x == 0u) lo += specular(xo, no, wo);
     radiance = vec4(lo, 1.0);

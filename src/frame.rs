@@ -9,6 +9,7 @@ use crate::bad_input;
 use crate::batching::{FrameShading, ShadeBatching};
 use crate::error::Result;
 use crate::frame_desc::{FrameDesc, Show};
+use crate::gpu::sd_table::AngularFactors;
 use crate::gpu::{DebugConstants, FrameParams, ShadeConstants, WorkCounters};
 use crate::gpu_world::{GpuObject, GpuWorld};
 use crate::hierarchy::Hierarchy;
@@ -398,11 +399,24 @@ pub struct HierarchyPasses {
     irradiance: IrradiancePass,
     sort: SortPass,
     tree: TreePass,
+    /// An Sd table buffer with no angular factors (all 1): what [`HierarchyPasses::record`]'s
+    /// irradiance reads for a hierarchy without an object.
+    no_factors: Buffer,
 }
 
 impl HierarchyPasses {
     pub fn new(ctx: &Context) -> Result<HierarchyPasses> {
+        let table_texels = crate::gpu::sd_table::TABLE_SIZE;
+        let mut no_factors = Buffer::new(
+            ctx,
+            "no angular factors",
+            ((table_texels + AngularFactors::TEXELS) * 16) as u64,
+            BufferUsageFlags::UNIFORM_TEXEL_BUFFER,
+            MemoryLocation::CpuToGpu,
+        )?;
+        no_factors.write((table_texels * 16) as u64, &AngularFactors::none().texels())?;
         Ok(HierarchyPasses {
+            no_factors,
             sampling: SamplingPass::new(ctx)?,
             shadow: ShadowPass::new(ctx)?,
             irradiance: IrradiancePass::new(ctx)?,
@@ -414,7 +428,7 @@ impl HierarchyPasses {
     /// The frame's first seven passes: `h` rebuilt from the mesh in `vertices` and `indices`,
     /// alone in the world. Tests and tools record them so to build a hierarchy.
     pub fn record(&self, rec: &mut Recorder, h: &Hierarchy, vertices: &Buffer, indices: &Buffer) -> Result<()> {
-        self.record_among(rec, h, vertices, indices, &[(vertices, indices, h.index_count)])
+        self.record_among(rec, h, vertices, indices, &self.no_factors, &[(vertices, indices, h.index_count)])
     }
 
     /// Every mesh of `casters` into the maps of `shadows`.
@@ -428,13 +442,14 @@ impl HierarchyPasses {
     }
 
     /// The same among other objects: `casters` (every object's mesh, this one's included) cast
-    /// the shadows its irradiance sees.
+    /// the shadows its irradiance sees; `sd_table` is the object's (its angular factors).
     pub fn record_among(
         &self,
         rec: &mut Recorder,
         h: &Hierarchy,
         vertices: &Buffer,
         indices: &Buffer,
+        sd_table: &Buffer,
         casters: &[(&Buffer, &Buffer, u32)],
     ) -> Result<()> {
         let n = h.point_count;
@@ -451,7 +466,8 @@ impl HierarchyPasses {
         rec.scope("irradiance", |rec| {
             let (points, flux, lights) = (&h.points, (&h.point_flux, &h.point_spread), &shadows.lights);
             let records = (&h.point_lights, h.per_light_count > 0);
-            self.irradiance.record(rec, points, records, flux, n, lights, &shadows.shadow_map, &shadows.shadow_sampler)
+            let shadow = (&shadows.shadow_map, &shadows.shadow_sampler);
+            self.irradiance.record(rec, points, records, flux, n, lights, shadow.0, shadow.1, sd_table)
         })?;
         // A key per point along a Morton curve through the mesh's box.
         rec.scope("morton codes", |rec| self.sort.record_morton(rec, &sort, n, h.bounds()))?;
@@ -543,7 +559,14 @@ impl Renderer {
             for o in &self.world.objects {
                 // Each object's hierarchy, rebuilt from its mesh: seven passes (listed in
                 // `HierarchyPasses::record`), its shadow maps seeing every object.
-                self.passes.hierarchy.record_among(rec, &o.hierarchy, &o.vertices, &o.indices, &casters)?;
+                self.passes.hierarchy.record_among(
+                    rec,
+                    &o.hierarchy,
+                    &o.vertices,
+                    &o.indices,
+                    &o.sd_table,
+                    &casters,
+                )?;
             }
             if let Some(shadows) = &w.opaque_shadows {
                 // The opaque objects' shadow maps, of every object.

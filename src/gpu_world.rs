@@ -9,11 +9,13 @@ use crate::bad_input;
 use crate::budget::{self, FrameSizes};
 use crate::error::Result;
 use crate::frame_desc::FrameDesc;
+use crate::gpu::sd_table::AngularFactors;
 use crate::gpu::{DiffuseSurfaceConstants, GpuChannel, ObjectParams, SdTable};
 use crate::hierarchy::{self, Hierarchy, HierarchyOptions};
 use crate::materials::Material;
 use crate::mesh::Mesh;
 use crate::physics::beam_diffusion::BeamMedium;
+use crate::physics::mc_profile::McProfile;
 use crate::physics::{Diffusion, Model};
 use crate::scene::Light;
 use crate::shadows::Shadows;
@@ -56,12 +58,14 @@ struct MadeFrom {
 enum TableProfile {
     Dipole,
     BeamDiffusion,
+    MonteCarlo,
 }
 
 impl TableProfile {
     fn of(model: Model) -> TableProfile {
         match model {
             Model::Pbd => TableProfile::BeamDiffusion,
+            Model::Mc => TableProfile::MonteCarlo,
             Model::Directional | Model::Dipole => TableProfile::Dipole,
         }
     }
@@ -349,7 +353,8 @@ impl GpuObject {
         let mut sd_table = Buffer::new(
             ctx,
             "Sd table",
-            (crate::gpu::sd_table::TABLE_SIZE * 16) as u64, // a header texel and TABLE_SIZE - 1 pairs
+            // A header texel, TABLE_SIZE - 1 pairs and the angular factors.
+            ((crate::gpu::sd_table::TABLE_SIZE + AngularFactors::TEXELS) * 16) as u64,
             BufferUsageFlags::UNIFORM_TEXEL_BUFFER,
             MemoryLocation::CpuToGpu,
         )?;
@@ -389,11 +394,17 @@ fn write_params(params: &mut Buffer, table: &mut Buffer, from: &MadeFrom, point_
             pad: 0,
         }],
     )?;
-    let sd_table = match from.table {
-        TableProfile::Dipole => SdTable::dipole(&[0, 1, 2].map(constants)),
-        TableProfile::BeamDiffusion => {
-            SdTable::beam_diffusion(&[0, 1, 2].map(|c| BeamMedium::new(&from.material.channel(c))))
+    let (sd_table, factors) = match from.table {
+        TableProfile::Dipole => (SdTable::dipole(&[0, 1, 2].map(constants)), AngularFactors::none()),
+        TableProfile::BeamDiffusion => (
+            SdTable::beam_diffusion(&[0, 1, 2].map(|c| BeamMedium::new(&from.material.channel(c)))),
+            AngularFactors::none(),
+        ),
+        TableProfile::MonteCarlo => {
+            let profiles = McProfile::of_channels(&[0, 1, 2].map(|c| from.material.channel(c)));
+            (SdTable::monte_carlo(&profiles, &[0, 1, 2].map(constants)), AngularFactors::monte_carlo(&profiles))
         }
     };
-    table.write(0, &sd_table.texels())
+    table.write(0, &sd_table.texels())?;
+    table.write((crate::gpu::sd_table::TABLE_SIZE * 16) as u64, &factors.texels())
 }

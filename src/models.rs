@@ -4,7 +4,7 @@
 //! (shaders/include/) or a tabulated profile (`gpu::SdTable`, as photon beam diffusion), a `Model`
 //! variant and one entry in [`MODELS`].
 
-use crate::gpu::{MODEL_DIPOLE, MODEL_DIRECTIONAL, MODEL_PBD};
+use crate::gpu::{MODEL_DIPOLE, MODEL_DIRECTIONAL, MODEL_MC, MODEL_PBD};
 use crate::physics::Model;
 
 /// One model's registration.
@@ -48,6 +48,14 @@ pub const MODELS: &[ModelEntry] = &[
         label: "beam diffusion",
         gpu_code: MODEL_PBD,
         about: "photon beam diffusion, multiple and single scattering (Habel, Christensen, Jarosz 2013)",
+    },
+    ModelEntry {
+        model: Model::Mc,
+        name: "mc",
+        aliases: &["monte-carlo"],
+        label: "Monte Carlo table",
+        gpu_code: MODEL_MC,
+        about: "the flat half-space's exact transport, tabulated by Monte Carlo: radial profile, incidence and exit factors",
     },
 ];
 
@@ -109,6 +117,6 @@ mod tests {
         assert_eq!(Model::Directional.next(), Model::Dipole);
         assert_eq!(Model::Dipole.next(), Model::Pbd);
         assert_eq!(Model::Pbd.next(), Model::Directional);
-        assert_eq!(Model::names(), "directional, dipole or pbd");
+        assert_eq!(Model::names(), "directional, dipole, pbd or mc");
     }
 }

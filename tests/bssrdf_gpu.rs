@@ -30,7 +30,7 @@ fn compare(queries: &[Query], gpu: &[f32], model: Model) -> Report {
                 let (real, virt) = dirpole::terms(&c, q.xi, q.ni, q.wi, q.xo, q.no);
                 real.abs().max(virt.abs()) > 10.0 * (real - virt).abs()
             }
-            Model::Dipole | Model::Pbd => false,
+            Model::Dipole | Model::Pbd | Model::Mc => false,
         };
         let rel = (g as f64 - cpu).abs() / cpu;
         if cancelling {
@@ -82,14 +82,15 @@ fn gpu_matches_the_reference_file() {
     assert_clean(&counts);
 }
 
-/// Photon beam diffusion on the GPU reads a table per medium, as the shade pass does: random
+/// The table models (photon beam diffusion, the Monte Carlo table) on the GPU read a table per
+/// medium, as the shade pass does: random
 /// geometry over eight preset media (rows of one medium share a table). Against the same table
 /// read in f64 (`SdTable::lookup`): within 1e-4 relative plus 1e-3 of the interval's step (f32's
 /// rounding of where in the interval r falls); against the f64 profile itself within 2e-3 from
 /// the table's 16th entry on, down to 1e-6 of its peak (its interpolation, tests in
 /// src/gpu/sd_table.rs).
 #[test]
-fn gpu_beam_diffusion_matches_cpu() {
+fn gpu_table_models_match_cpu() {
     use translucent::gpu::sd_table::TABLE_SIZE;
     use translucent::materials::Material;
     let media: Vec<_> = ["skin1", "marble", "ketchup", "potato"]
@@ -105,32 +106,39 @@ fn gpu_beam_diffusion_matches_cpu() {
     }
     let (ctx, counts) = validated_context();
     let pass = BssrdfEvalPass::new(&ctx).unwrap();
-    let gpu = pass.evaluate(&ctx, &queries, Model::Pbd, Diffusion::Classical).unwrap();
-    let tables: Vec<SdTable> = media.iter().map(|m| SdTable::beam_diffusion_one(&BeamMedium::new(m))).collect();
-    let (mut worst_table, mut worst_profile, mut checked) = (0.0f64, 0.0f64, 0);
-    for (i, (q, &g)) in queries.iter().zip(&gpu).enumerate() {
-        let table = &tables[i % media.len()];
-        let r = (q.xo - q.xi).length();
-        let cpu_table = table.lookup(r)[0];
-        let x = r / (r + table.reach) * (TABLE_SIZE - 1) as f64;
-        let k = (x.floor() as usize).min(TABLE_SIZE - 2);
-        let step = (table.lookup_entry(k) - table.lookup_entry(k + 1)).abs();
-        let err = (g as f64 - cpu_table).abs();
-        assert!(err <= 1e-4 * cpu_table + 1e-3 * step + 1e-30, "row {i}: GPU {g} vs table {cpu_table} (r {r})");
-        worst_table = worst_table.max(err / cpu_table.max(1e-30));
-        if x >= 16.0 {
-            let profile = q.sd(Model::Pbd, Diffusion::Classical);
-            // Where f16 keeps its precision (down to 2e-9 of the peak; 1e-6 here).
-            if profile > 1e-6 * table.scale[0] as f64 * 32768.0 {
-                let rel = (g as f64 / profile - 1.0).abs();
-                assert!(rel <= 2e-3, "row {i}: GPU {g} vs profile {profile} (r {r})");
-                worst_profile = worst_profile.max(rel);
-                checked += 1;
+    // Both table models: photon beam diffusion and the Monte Carlo table.
+    for model in [Model::Pbd, Model::Mc] {
+        let gpu = pass.evaluate(&ctx, &queries, model, Diffusion::Classical).unwrap();
+        let table_of = |m: &translucent::physics::Medium| match model {
+            Model::Mc => SdTable::monte_carlo_one(m),
+            _ => SdTable::beam_diffusion_one(&BeamMedium::new(m)),
+        };
+        let tables: Vec<SdTable> = media.iter().map(table_of).collect();
+        let (mut worst_table, mut worst_profile, mut checked) = (0.0f64, 0.0f64, 0);
+        for (i, (q, &g)) in queries.iter().zip(&gpu).enumerate() {
+            let table = &tables[i % media.len()];
+            let r = (q.xo - q.xi).length();
+            let cpu_table = table.lookup(r)[0];
+            let x = r / (r + table.reach) * (TABLE_SIZE - 1) as f64;
+            let k = (x.floor() as usize).min(TABLE_SIZE - 2);
+            let step = (table.lookup_entry(k) - table.lookup_entry(k + 1)).abs();
+            let err = (g as f64 - cpu_table).abs();
+            assert!(err <= 1e-4 * cpu_table + 1e-3 * step + 1e-30, "row {i}: GPU {g} vs table {cpu_table} (r {r})");
+            worst_table = worst_table.max(err / cpu_table.max(1e-30));
+            if x >= 16.0 {
+                let profile = q.sd(model, Diffusion::Classical);
+                // Where f16 keeps its precision (down to 2e-9 of the peak; 1e-6 here).
+                if profile > 1e-6 * table.scale[0] as f64 * 32768.0 {
+                    let rel = (g as f64 / profile - 1.0).abs();
+                    assert!(rel <= 2e-3, "row {i}: GPU {g} vs profile {profile} (r {r})");
+                    worst_profile = worst_profile.max(rel);
+                    checked += 1;
+                }
             }
         }
+        println!("{}: worst relative to the f64 table {worst_table:.2e}; to the profile {worst_profile:.2e} over {checked} rows", model.name());
+        assert!(checked >= 2_000, "only {checked} rows checked");
     }
-    println!("pbd: worst relative to the f64 table {worst_table:.2e}; to the profile {worst_profile:.2e} over {checked} rows");
-    assert!(checked >= 2_000, "only {checked} rows checked");
     drop(pass);
     drop(ctx);
     assert_clean(&counts);

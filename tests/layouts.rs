@@ -220,6 +220,7 @@ fn shared_constants_are_the_rust_ones() {
     assert_eq!(value("MODEL_DIRECTIONAL"), Some(Model::Directional.gpu_code()));
     assert_eq!(value("MODEL_DIPOLE"), Some(Model::Dipole.gpu_code()));
     assert_eq!(value("MODEL_PBD"), Some(Model::Pbd.gpu_code()));
+    assert_eq!(value("MODEL_MC"), Some(Model::Mc.gpu_code()));
     assert_ne!(Model::Directional.gpu_code(), Model::Dipole.gpu_code());
     assert_eq!(value("LEAF_BIT"), Some(gpu::LEAF_BIT));
     assert_eq!(value("RADIX_TILE"), Some(gpu::RADIX_TILE));

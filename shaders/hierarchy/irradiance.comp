@@ -14,6 +14,8 @@ layout(binding = 2) uniform sampler2DArrayShadow shadow_map;
 layout(std430, binding = 3) writeonly buffer PointLights { PointLight point_lights[]; };
 layout(std430, binding = 4) writeonly buffer PointFluxes { PointFlux point_flux[]; };
 layout(std430, binding = 5) writeonly buffer PointSpreads { PointSpread point_spread[]; };
+// The object's Sd table, for its angular factors' incidence part (1 but for the Monte Carlo table).
+layout(binding = 6) uniform usamplerBuffer sd_table;
 layout(push_constant) uniform IrradianceConstants { uint point_count; uint per_light_records; } pc;
 
 // The two sigma axes of the directions' covariance (PointSpread): Jacobi rotations of the 3×3
@@ -78,14 +80,15 @@ void main() {
         vec4 clip = layer_matrix(layer) * vec4(p.position + p.normal * light_set.normal_offset, 1.0);
         vec3 ndc = clip.xyz / clip.w;
         float visibility = texture(shadow_map, vec4(ndc.xy * 0.5 + 0.5, float(layer), ndc.z));
-        vec3 e = incident * cos_theta * fresnel_transmittance(light_set.eta, cos_theta) * visibility;
-        if (pc.per_light_records != 0u) point_lights[record].irradiance = e;
-        if (e == vec3(0.0)) continue;
         // The same direction brute force refracts from the decoded record, so that one light's
         // merged record is that light's own; cos θt as refract_in computes it.
         vec3 wi = decode_oct(encode_oct(toward));
         float cos_i = dot(wi, p.normal);
         float cos_t = sqrt(max(1.0 - (1.0 - cos_i * cos_i) / (light_set.eta * light_set.eta), 0.0));
+        vec3 e = incident * cos_theta * fresnel_transmittance(light_set.eta, cos_theta) * visibility
+               * table_incidence_factor(sd_table, cos_t);
+        if (pc.per_light_records != 0u) point_lights[record].irradiance = e;
+        if (e == vec3(0.0)) continue;
         for (uint c = 0u; c < 3u; ++c) flux.incident[c] += e[c] * vec4(wi, cos_t);
         float y = dot(e, vec3(0.2126, 0.7152, 0.0722));
         vec3 w12 = refract_in(wi, p.normal, light_set.eta);

@@ -71,6 +71,36 @@ vec3 sd_table_at(usamplerBuffer table, int base, vec4 header, float r) {
     return header.xyz * mix(vec3(red.x, green.x, blue.x), vec3(red.y, green.y, blue.y), x - i);
 }
 vec4 dipole_table_header(usamplerBuffer table) { return sd_table_header_at(table, 0); }
+
+// A table model's angular factors after its Sd table (mirrors gpu::sd_table::AngularFactors; 1
+// for the dipole and beam diffusion, the Monte Carlo table's measured ones for `mc`): texel
+// DIPOLE_TABLE_SIZE + k holds the incidence factor f(θt) at node k (nodes equally spaced in
+// cos θt from w, grazing entry, to 1), then per node MC_EXIT_BINS texels the exit factor
+// h(θt, θo) per bin of cos²θo; linear between nodes (bin centres), as a + (b - a)t so that ones
+// stay exactly 1.
+vec3 table_incidence_factor(usamplerBuffer table, float cos_t) {
+    int base = int(DIPOLE_TABLE_SIZE);
+    float lo = uintBitsToFloat(texelFetch(table, base).w);
+    float x = clamp((cos_t - lo) / (1.0 - lo), 0.0, 1.0) * float(MC_INCIDENCE_NODES - 1u);
+    float i = min(floor(x), float(MC_INCIDENCE_NODES - 2u));
+    vec3 a = uintBitsToFloat(texelFetch(table, base + int(i)).xyz);
+    vec3 b = uintBitsToFloat(texelFetch(table, base + int(i) + 1).xyz);
+    return a + (b - a) * (x - i);
+}
+vec3 table_exit_factor(usamplerBuffer table, float cos_t, float cos_o) {
+    int base = int(DIPOLE_TABLE_SIZE);
+    float lo = uintBitsToFloat(texelFetch(table, base).w);
+    float x = clamp((cos_t - lo) / (1.0 - lo), 0.0, 1.0) * float(MC_INCIDENCE_NODES - 1u);
+    float i = min(floor(x), float(MC_INCIDENCE_NODES - 2u));
+    float y = clamp(cos_o * cos_o * float(MC_EXIT_BINS) - 0.5, 0.0, float(MC_EXIT_BINS - 1u));
+    float j = min(floor(y), float(MC_EXIT_BINS - 2u));
+    int row = base + int(MC_INCIDENCE_NODES) + int(i) * int(MC_EXIT_BINS) + int(j);
+    vec3 a0 = uintBitsToFloat(texelFetch(table, row).xyz), b0 = uintBitsToFloat(texelFetch(table, row + 1).xyz);
+    vec3 a1 = uintBitsToFloat(texelFetch(table, row + int(MC_EXIT_BINS)).xyz);
+    vec3 b1 = uintBitsToFloat(texelFetch(table, row + int(MC_EXIT_BINS) + 1).xyz);
+    vec3 h0 = a0 + (b0 - a0) * (y - j), h1 = a1 + (b1 - a1) * (y - j);
+    return h0 + (h1 - h0) * (x - i);
+}
 vec3 dipole_sd_table(usamplerBuffer table, vec4 header, float r) { return sd_table_at(table, 0, header, r); }
 
 // The ray-source term S'(x, w, r) of the directional dipole.

@@ -10,6 +10,12 @@ pub const MODEL_DIRECTIONAL: u32 = 0;
 pub const MODEL_DIPOLE: u32 = 1;
 /// The same for photon beam diffusion (read from its Sd table like the classical dipole's).
 pub const MODEL_PBD: u32 = 2;
+/// The same for the half-space's Monte Carlo table (its Sd table, and the angular factors after it).
+pub const MODEL_MC: u32 = 3;
+/// Nodes of the Monte Carlo table's incidence factor and bins of its exit factor
+/// (src/physics/mc_profile.rs's INCIDENCE_NODES and EXIT_BINS; checked equal in gpu::sd_table).
+pub const MC_INCIDENCE_NODES: u32 = 8;
+pub const MC_EXIT_BINS: u32 = 10;
 
 /// Set in a tree node's child index when the child is a point (index into the sorted points).
 pub const LEAF_BIT: u32 = 0x8000_0000;
@@ -38,6 +44,9 @@ pub const GLSL_CONSTANTS: &[(&str, u32)] = &[
     ("MODEL_DIRECTIONAL", MODEL_DIRECTIONAL),
     ("MODEL_DIPOLE", MODEL_DIPOLE),
     ("MODEL_PBD", MODEL_PBD),
+    ("MODEL_MC", MODEL_MC),
+    ("MC_INCIDENCE_NODES", MC_INCIDENCE_NODES),
+    ("MC_EXIT_BINS", MC_EXIT_BINS),
     ("LEAF_BIT", LEAF_BIT),
     ("RADIX_TILE", RADIX_TILE),
     ("TILE_SIZE", TILE_SIZE),

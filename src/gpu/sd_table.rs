@@ -3,6 +3,7 @@
 //! beam diffusion's [`crate::physics::beam_diffusion::sd`] and tested against them.
 
 use crate::physics::beam_diffusion::{self, BeamMedium};
+use crate::physics::mc_profile::{self, McProfile};
 use crate::physics::{dipole, ChannelConstants};
 
 /// Entries of [`SdTable`] (shared with bssrdf.glsl).
@@ -110,6 +111,71 @@ impl SdTable {
         let (a, b) = (self.values[i], self.values[i + 1]);
         [0, 1, 2].map(|c| self.scale[c] as f64 * (half_value(a[c]) * (1.0 - f) + half_value(b[c]) * f))
     }
+}
+
+impl SdTable {
+    /// The half-space Monte Carlo's table (`--model mc`): its measured radial profile. The same
+    /// reach as the classical dipole's.
+    pub fn monte_carlo(profiles: &[std::sync::Arc<McProfile>; 3], channels: &[ChannelConstants; 3]) -> SdTable {
+        let sigma_tr =
+            channels.iter().filter(|c| c.transports).map(|c| c.dipole_sigma_tr).fold(f64::INFINITY, f64::min);
+        SdTable::from_profile(reach_of(sigma_tr), |c, r| profiles[c].sd(r))
+    }
+
+    /// The Monte Carlo table of one medium, in channel 0 (`bssrdf --gpu`'s, as
+    /// [`SdTable::beam_diffusion_one`]).
+    pub fn monte_carlo_one(m: &crate::physics::Medium) -> SdTable {
+        let c = m.constants(crate::physics::Diffusion::Classical);
+        let profile = McProfile::of(m);
+        let reach = reach_of(if c.transports { c.dipole_sigma_tr } else { f64::INFINITY });
+        SdTable::from_profile(reach, |ch, r| if ch == 0 { profile.sd(r) } else { 0.0 })
+    }
+}
+
+const _: () = assert!(mc_profile::INCIDENCE_NODES == super::MC_INCIDENCE_NODES as usize);
+const _: () = assert!(mc_profile::EXIT_BINS == super::MC_EXIT_BINS as usize);
+
+/// The angular factors of a table model, after its Sd table in the same buffer (bssrdf.glsl's
+/// `table_incidence_factor`, `table_exit_factor`): the Monte Carlo table's f(θt) and h(θt, θo)
+/// ([`McProfile`]), 1 for the other models (which the shaders then multiply by exactly 1).
+#[derive(Clone, Debug, PartialEq)]
+pub struct AngularFactors {
+    /// cos θt of incidence node 0.
+    pub cos_t_min: f32,
+    pub incidence: [[f32; 3]; mc_profile::INCIDENCE_NODES],
+    /// Per incidence node, per exit bin.
+    pub exit: [[[f32; 3]; mc_profile::EXIT_BINS]; mc_profile::INCIDENCE_NODES],
+}
+
+impl AngularFactors {
+    /// No factors: 1 at every node.
+    pub fn none() -> AngularFactors {
+        AngularFactors {
+            cos_t_min: 0.0,
+            incidence: [[1.0; 3]; mc_profile::INCIDENCE_NODES],
+            exit: [[[1.0; 3]; mc_profile::EXIT_BINS]; mc_profile::INCIDENCE_NODES],
+        }
+    }
+
+    /// The Monte Carlo table's (the channels share η, so cos θt of node 0 too).
+    pub fn monte_carlo(profiles: &[std::sync::Arc<McProfile>; 3]) -> AngularFactors {
+        AngularFactors {
+            cos_t_min: profiles[0].cos_t_min as f32,
+            incidence: std::array::from_fn(|k| [0, 1, 2].map(|c| profiles[c].incidence[k] as f32)),
+            exit: std::array::from_fn(|k| std::array::from_fn(|b| [0, 1, 2].map(|c| profiles[c].exit[k][b] as f32))),
+        }
+    }
+
+    /// Texel TABLE_SIZE + k of the object's table buffer: the incidence factors at node k (and,
+    /// in w, cos θt of node 0), then the exit factors, node by node, bin by bin (f32 bits).
+    pub fn texels(&self) -> Vec<[u32; 4]> {
+        let incidence = self.incidence.iter().map(|f| [f[0], f[1], f[2], self.cos_t_min].map(f32::to_bits));
+        let exit = self.exit.iter().flatten().map(|h| [h[0], h[1], h[2], 0.0].map(f32::to_bits));
+        incidence.chain(exit).collect()
+    }
+
+    /// Texels after the Sd table.
+    pub const TEXELS: usize = mc_profile::INCIDENCE_NODES * (1 + mc_profile::EXIT_BINS);
 }
 
 /// Beam diffusion's entry at `r` of a table of `reach`: Sd, but at r = 0 the v0 for which the

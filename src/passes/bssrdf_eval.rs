@@ -39,7 +39,7 @@ impl BssrdfEvalPass {
         let mut out = Vec::with_capacity(queries.len());
         let max_tables = MAX_TABLES.min(ctx.limits().max_texel_buffer_elements as usize / TABLE_SIZE).max(1);
         for part in queries.chunks(chunk) {
-            if model != Model::Pbd {
+            if !matches!(model, Model::Pbd | Model::Mc) {
                 let placeholder = texel_buffer(ctx, &[[0u32; 4]])?;
                 out.extend(self.dispatch(ctx, part, &vec![0; part.len()], &placeholder, model, diffusion)?);
                 continue;
@@ -64,8 +64,11 @@ impl BssrdfEvalPass {
                     };
                     rows_table.push(table);
                 }
-                let texels: Vec<[u32; 4]> =
-                    media.iter().flat_map(|m| SdTable::beam_diffusion_one(&BeamMedium::new(m)).texels()).collect();
+                let table_of = |m: &Medium| match model {
+                    Model::Mc => SdTable::monte_carlo_one(m),
+                    _ => SdTable::beam_diffusion_one(&BeamMedium::new(m)),
+                };
+                let texels: Vec<[u32; 4]> = media.iter().flat_map(|m| table_of(m).texels()).collect();
                 let tables = texel_buffer(ctx, &texels)?;
                 let end = start + rows_table.len();
                 out.extend(self.dispatch(ctx, &part[start..end], &rows_table, &tables, model, diffusion)?);

@@ -1,5 +1,5 @@
 //! Irradiance at each point from every light, with shadow-map visibility and Fresnel transmittance.
-//! Reads: lights, shadow map. Writes: points (irradiance, mean light direction), every light's
+//! Reads: lights, shadow map, the object's Sd table (its incidence factors). Writes: points (irradiance, mean light direction), every light's
 //! merged record of each point, and (for brute force) each light's own.
 
 use crate::error::Result;
@@ -25,6 +25,7 @@ impl IrradiancePass {
         lights: &Buffer,
         shadow_map: &Image,
         sampler: &Sampler,
+        sd_table: &Buffer,
     ) -> Result<()> {
         rec.dispatch(
             &self.pipeline,
@@ -35,6 +36,7 @@ impl IrradiancePass {
                 Bind::Write(point_lights),
                 Bind::Write(point_flux),
                 Bind::Write(point_spread),
+                Bind::Texels(sd_table),
             ],
             bytemuck::bytes_of(&[point_count, per_light_records as u32]),
             [point_count.div_ceil(64), 1, 1],

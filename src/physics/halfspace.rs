@@ -209,23 +209,36 @@ impl SplitMix {
     }
 }
 
-/// The exact radiative transfer answer for a half-space of reduced albedo `albedo` and relative
-/// index `eta` (isotropic scattering, smooth boundary) lit by a beam at cos θi = `cos_i`, by
-/// analogue Monte Carlo with `photons` photons: entry through the boundary with weight Ft(θi),
-/// exponential free paths, absorption with probability 1 − α' at each collision, Fresnel
-/// reflection or escape (with refraction) at the boundary.
-pub fn rte_reflectance(albedo: f64, eta: f64, cos_i: f64, photons: u64, seed: u64) -> RteTally {
+/// Where a photon of [`trace_half_space`] left the medium: its position on the boundary relative
+/// to the entry point (mean free paths), cos²θo outside and how often it scattered.
+#[derive(Clone, Copy, Debug)]
+pub struct Escape {
+    pub x: f64,
+    pub y: f64,
+    pub mu_o2: f64,
+    pub scatterings: u32,
+}
+
+/// Collisions after which a photon counts as absorbed: far past any path that matters for
+/// α' < 1 (its weight α'^n), and an end for α' = 1, whose returns take arbitrarily long.
+pub const MAX_COLLISIONS: u32 = 1_000_000;
+
+/// The analogue Monte Carlo walk of a half-space (z < 0) of reduced albedo `albedo`, relative
+/// index `eta`, isotropic scattering, smooth boundary, in mean free paths: `photons` photons start
+/// at the origin going `start` (downward), fly exponential free paths, are absorbed with
+/// probability 1 − α' at each collision, and at the boundary are Fresnel-reflected or escape (with
+/// refraction), which `on_escape` is told.
+pub fn trace_half_space(
+    albedo: f64,
+    eta: f64,
+    start: DVec3,
+    photons: u64,
+    seed: u64,
+    mut on_escape: impl FnMut(&Escape),
+) {
     let mut rng = SplitMix(seed);
-    let sin_i = (1.0 - cos_i * cos_i).max(0.0).sqrt();
-    // Refracted direction (z down into the medium is negative).
-    let sin_t = sin_i / eta;
-    let start = DVec3::new(sin_t, 0.0, -(1.0 - sin_t * sin_t).sqrt());
-    let entry = fresnel::transmittance(eta, cos_i);
-    let mut escaped = vec![0u64; RADIANCE_BINS];
-    let mut count = 0u64;
-    let mut once = 0u64;
     for _ in 0..photons {
-        let mut z = 0.0f64;
+        let (mut x, mut y, mut z) = (0.0f64, 0.0f64, 0.0f64);
         let mut d = start;
         let mut scatterings = 0u32;
         loop {
@@ -233,20 +246,22 @@ pub fn rte_reflectance(albedo: f64, eta: f64, cos_i: f64, photons: u64, seed: u6
             let z_next = z + s * d.z;
             if z_next >= 0.0 {
                 // Reaches the boundary from inside: the cosine there is d.z > 0.
+                let t = -z / d.z;
+                x += t * d.x;
+                y += t * d.y;
                 if rng.next() < fresnel::reflectance(1.0 / eta, d.z) {
                     d.z = -d.z;
                     z = 0.0;
                     continue;
                 }
                 let mu_o2 = 1.0 - eta * eta * (1.0 - d.z * d.z);
-                let k = ((mu_o2.clamp(0.0, 1.0) * RADIANCE_BINS as f64) as usize).min(RADIANCE_BINS - 1);
-                escaped[k] += 1;
-                count += 1;
-                once += (scatterings == 1) as u64;
+                on_escape(&Escape { x, y, mu_o2: mu_o2.clamp(0.0, 1.0), scatterings });
                 break;
             }
+            x += s * d.x;
+            y += s * d.y;
             z = z_next;
-            if rng.next() >= albedo {
+            if rng.next() >= albedo || scatterings >= MAX_COLLISIONS {
                 break;
             }
             scatterings += 1;
@@ -256,6 +271,30 @@ pub fn rte_reflectance(albedo: f64, eta: f64, cos_i: f64, photons: u64, seed: u6
             d = DVec3::new(s * phi.cos(), s * phi.sin(), mu);
         }
     }
+}
+
+/// The refracted direction of light entering at cos θi = `cos_i` (z down into the medium is
+/// negative), in the xz plane.
+pub fn entry_direction(eta: f64, cos_i: f64) -> DVec3 {
+    let sin_t = (1.0 - cos_i * cos_i).max(0.0).sqrt() / eta;
+    DVec3::new(sin_t, 0.0, -(1.0 - sin_t * sin_t).sqrt())
+}
+
+/// The exact radiative transfer answer for a half-space of reduced albedo `albedo` and relative
+/// index `eta` (isotropic scattering, smooth boundary) lit by a beam at cos θi = `cos_i`, by
+/// analogue Monte Carlo with `photons` photons ([`trace_half_space`], entry through the boundary
+/// with weight Ft(θi)).
+pub fn rte_reflectance(albedo: f64, eta: f64, cos_i: f64, photons: u64, seed: u64) -> RteTally {
+    let entry = fresnel::transmittance(eta, cos_i);
+    let mut escaped = vec![0u64; RADIANCE_BINS];
+    let mut count = 0u64;
+    let mut once = 0u64;
+    trace_half_space(albedo, eta, entry_direction(eta, cos_i), photons, seed, |e| {
+        let k = ((e.mu_o2 * RADIANCE_BINS as f64) as usize).min(RADIANCE_BINS - 1);
+        escaped[k] += 1;
+        count += 1;
+        once += (e.scatterings == 1) as u64;
+    });
     let n = photons as f64;
     let p = count as f64 / n;
     let p1 = once as f64 / n;

@@ -10,6 +10,7 @@ pub mod dipole;
 pub mod dirpole;
 pub mod fresnel;
 pub mod halfspace;
+pub mod mc_profile;
 pub mod microfacet;
 
 /// Which diffusion coefficient the directional dipole uses.
@@ -32,6 +33,8 @@ pub enum Model {
     Dipole,
     /// Photon beam diffusion, multiple and single scattering: Habel, Christensen, Jarosz 2013.
     Pbd,
+    /// The half-space's exact transport, tabulated by Monte Carlo (src/physics/mc_profile.rs).
+    Mc,
 }
 
 /// One colour channel of a medium.
@@ -137,6 +140,8 @@ impl Query {
             Model::Pbd => {
                 beam_diffusion::sd(&beam_diffusion::BeamMedium::new(&self.medium), (self.xo - self.xi).length())
             }
+            // The radial part alone; its incidence and exit factors are the profile's.
+            Model::Mc => mc_profile::McProfile::of(&self.medium).sd((self.xo - self.xi).length()),
         }
     }
 }

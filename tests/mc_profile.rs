@@ -1,0 +1,84 @@
+//! The Monte Carlo table (`--model mc`, src/physics/mc_profile.rs) against Chandrasekhar's exact
+//! half-space where the index matches (η = 1): its escape fraction, its incidence factor and its
+//! exit factor, each within the Monte Carlo's own noise. No GPU. (Its render of a thick slab is
+//! tests/subsurface.rs; against the path tracer, tests/ground_truth.rs.)
+
+use translucent::physics::halfspace::{h_function, index_matched_plane_albedo};
+use translucent::physics::mc_profile::{self, McProfile, EXIT_BINS, INCIDENCE_NODES};
+use translucent::physics::Medium;
+
+/// An index-matched medium of albedo `albedo` (σ't = 1/mm).
+fn matched(albedo: f64) -> McProfile {
+    (*McProfile::of(&Medium { sigma_a: 1.0 - albedo, sigma_s: albedo, g: 0.0, eta: 1.0 })).clone()
+}
+
+/// Escape at normal incidence: 1 − H(1)√(1 − ϖ); at each incidence node μ0 (= cos θt at η = 1)
+/// the factor f = (1 − H(μ0)√(1 − ϖ)) / (1 − H(1)√(1 − ϖ)). Within 4σ of the escapes counted.
+#[test]
+fn escape_and_incidence_factor_match_chandrasekhar() {
+    for albedo in [0.5, 0.9, 0.99] {
+        let p = matched(albedo);
+        let exact = index_matched_plane_albedo(albedo, 1.0);
+        let sigma = |escapes: u64| 1.0 / (escapes as f64).sqrt();
+        println!("ϖ {albedo}: escape {:.5} vs {exact:.5}", p.escape);
+        assert!(
+            (p.escape / exact - 1.0).abs() < 4.0 * sigma(mc_profile::ESCAPES_NORMAL),
+            "ϖ {albedo}: {} vs {exact}",
+            p.escape
+        );
+        for k in 0..INCIDENCE_NODES - 1 {
+            let mu0 = mc_profile::incidence_node(p.cos_t_min, k);
+            let expected = index_matched_plane_albedo(albedo, mu0) / exact;
+            let tolerance = 4.0 * sigma(mc_profile::ESCAPES_OBLIQUE) + 4.0 * sigma(mc_profile::ESCAPES_NORMAL);
+            println!("  μ0 {mu0:.3}: f {:.4} vs {expected:.4}", p.incidence[k]);
+            assert!(
+                (p.incidence[k] / expected - 1.0).abs() < tolerance,
+                "ϖ {albedo} μ0 {mu0}: {} vs {expected}",
+                p.incidence[k]
+            );
+        }
+    }
+}
+
+/// The exit factor against Chandrasekhar's reflection function: radiance per unit irradiance
+/// L(μ) = ϖ H(μ) H(μ0) / (4π(μ + μ0)), over the lobe the renderer puts on the escaping light
+/// (Ft = 1 and ∫Ft cos θ dω = π at η = 1): h = L·π / escape, averaged over each bin of cos²θo;
+/// at normal incidence and at the most grazing node. Within 4σ of the bin's count.
+#[test]
+fn exit_factor_matches_chandrasekhar() {
+    let albedo = 0.9;
+    let p = matched(albedo);
+    for (k, escapes) in [(INCIDENCE_NODES - 1, mc_profile::ESCAPES_NORMAL), (0, mc_profile::ESCAPES_OBLIQUE)] {
+        let mu0 = mc_profile::incidence_node(p.cos_t_min, k);
+        let escape = index_matched_plane_albedo(albedo, mu0);
+        let h0 = h_function(albedo, mu0);
+        for b in 0..EXIT_BINS {
+            let sub = 16;
+            let expected = (0..sub)
+                .map(|j| {
+                    let mu = ((b as f64 + (j as f64 + 0.5) / sub as f64) / EXIT_BINS as f64).sqrt();
+                    albedo * h_function(albedo, mu) * h0 / (4.0 * (mu + mu0)) / escape
+                })
+                .sum::<f64>()
+                / sub as f64;
+            // A bin holds about h/EXIT_BINS of the escapes.
+            let tolerance = 4.0 / (expected * escapes as f64 / EXIT_BINS as f64).sqrt() + 4.0 / (escapes as f64).sqrt();
+            println!("μ0 {mu0:.3} bin {b}: h {:.4} vs {expected:.4}", p.exit[k][b]);
+            assert!(
+                (p.exit[k][b] / expected - 1.0).abs() < tolerance,
+                "μ0 {mu0} bin {b}: {} vs {expected}",
+                p.exit[k][b]
+            );
+        }
+    }
+}
+
+/// The profile is deterministic (fixed seeds) and its plane integral is its escape fraction.
+#[test]
+fn profile_is_reproducible_and_integrates_to_its_escape() {
+    let m = Medium { sigma_a: 0.17, sigma_s: 0.88, g: 0.0, eta: 1.3 };
+    let a = McProfile::of(&m);
+    assert_eq!(*a, McProfile::of_channels(&[m; 3])[0].as_ref().clone());
+    let plane = translucent::physics::halfspace::plane_integral(|x| a.exitance(x.length()), 1e-7, 400.0, 1);
+    assert!((plane / a.escape - 1.0).abs() < 5e-3, "{plane} vs {}", a.escape);
+}
