@@ -53,6 +53,8 @@ layout(std140, binding = 13) uniform Frame { FrameParams frame_params; };
 // PointFlux and PointSpread (sorted) as texels.
 layout(binding = 14) uniform usamplerBuffer point_flux;
 layout(binding = 15) uniform usamplerBuffer point_spread;
+// The same shadow map's depth, unfiltered: how far light travels inside (single scattering).
+layout(binding = 16) uniform sampler2DArray shadow_depth;
 vec4 dipole_header; // its texel 0, read once per pixel
 
 const uint STACK_SIZE = 96u;
@@ -211,6 +213,101 @@ float own_cos_t(vec3 xo, vec3 no) {
     return weight > 0.0 ? sum / weight : 1.0;
 }
 
+// Samples of the refracted view ray for single scattering (the first at the pixel): spaced as
+// s_k = reach · (k/N)², reach = SS_REACH mean free paths of the most translucent channel.
+const uint SS_SAMPLES = 24u;
+const float SS_REACH = 10.0;
+
+// Single scattering, the Monte Carlo table's (Jensen et al. 2001 §3; with its table's similarity
+// relation: σ's, σ't and an isotropic phase function). Along the refracted view ray
+// x(s) = xo + s·ωo' inside, light from each light scatters once toward the eye:
+//   Lo = Ft(θo)/η² · Σ_l E_l cos θl Ft(θl)/cos θtl · σs'/(4π) ∫ e^{−σ't (s + s_l(s))} ds,
+// s_l the light's refracted path inside: the straight distance from the surface its shadow map
+// sees toward it (the depth, unprojected), refracted as through a plane parallel to the pixel's
+// (exact on a flat half-space and a parallel slab, lit from either side). 1/η²: radiance leaving
+// a denser medium. Between samples s + s_l is taken linear, so each interval's integral is exact
+// there; samples the shadow map puts outside the object (nearer the light than its surface)
+// scatter nothing, and an interval with one such end counts half.
+vec3 single_scattering(vec3 xo, vec3 no, vec3 wo) {
+    float mm = object_params.mm_per_unit;
+    float eta = object_params.channels[0].eta;
+    vec3 sigma_s = vec3(object_params.channels[0].sigma_s_reduced, object_params.channels[1].sigma_s_reduced,
+                        object_params.channels[2].sigma_s_reduced);
+    vec3 sigma_t = vec3(object_params.channels[0].sigma_t_reduced, object_params.channels[1].sigma_t_reduced,
+                        object_params.channels[2].sigma_t_reduced);
+    float slowest = min(min(sigma_t.x > 0.0 ? sigma_t.x : 1e30, sigma_t.y > 0.0 ? sigma_t.y : 1e30),
+                        sigma_t.z > 0.0 ? sigma_t.z : 1e30);
+    if (slowest >= 1e30 || sigma_s == vec3(0.0)) return vec3(0.0);
+    float cos_o = max(dot(no, wo), 0.0);
+    if (cos_o <= 0.0) return vec3(0.0);
+    vec3 inward = refract_in(wo, no, eta);
+    float reach = SS_REACH / slowest;
+    float near_band = 2.0 * light_set.normal_offset * mm;
+    vec3 sum = vec3(0.0);
+    for (uint l = 0u; l < light_set.light_count; ++l) {
+        GpuLight light = light_of(l);
+        uint cached_layer = 0xffffffffu;
+        mat4 unproject = mat4(1.0);
+        vec3 along = vec3(0.0); // the interval integrals of e^{−σ't g}
+        float g_prev = 0.0, s_prev = 0.0;
+        bool inside_prev = false;
+        vec3 beam = vec3(0.0);
+        for (uint k = 0u; k <= SS_SAMPLES; ++k) {
+            float t = float(k) / float(SS_SAMPLES);
+            float s = reach * t * t; // mm
+            vec3 x = xo + inward * (s / mm);
+            vec3 toward;
+            uint layer;
+            vec3 incident = light_at(light, x, toward, layer);
+            vec4 clip = layer_matrix(layer) * vec4(x, 1.0);
+            vec3 ndc = clip.xyz / clip.w;
+            vec2 uv = ndc.xy * 0.5 + 0.5;
+            float depth = texture(shadow_depth, vec3(uv, float(layer))).r;
+            // Beyond the map or nearer the light than the surface it sees: outside the object.
+            // Within a few shadow texels of the pixel (the band its depth's rounding and bias
+            // blur) the ray is inside whatever the depth says.
+            bool near = s < near_band;
+            bool inside = all(greaterThanEqual(uv, vec2(0.0))) && all(lessThanEqual(uv, vec2(1.0))) && depth < 1.0
+                          && (near || ndc.z > depth);
+            float g = s;
+            if (inside) {
+                if (layer != cached_layer) {
+                    unproject = inverse(layer_matrix(layer));
+                    cached_layer = layer;
+                }
+                vec4 p = unproject * vec4(ndc.xy, depth, 1.0);
+                float cos_l = abs(dot(no, toward));
+                // The shadow pass's slope-scaled depth bias (1.5 texels of depth slope, texels
+                // normal_offset / 2 wide) moved the surface away from the light by about
+                // 0.75 normal_offset · tan θl: put it back.
+                float tan_l = sqrt(max(1.0 - cos_l * cos_l, 0.0)) / max(cos_l, 1e-3);
+                float straight = max(dot(p.xyz / p.w - x, toward) * mm + 0.75 * light_set.normal_offset * mm * tan_l, 0.0);
+                float cos_t = sqrt(max(1.0 - (1.0 - cos_l * cos_l) / (eta * eta), 0.0));
+                g = s + straight * cos_l / max(cos_t, 1e-6);
+                // The beam's flux inside per unit area across it (its irradiance at normal incidence outside).
+                beam = incident * cos_l * fresnel_transmittance(eta, cos_l) / max(cos_t, 1e-6);
+            }
+            if (k > 0u && (inside || inside_prev)) {
+                float ds = s - s_prev;
+                float slope = (g - g_prev) / ds; // d(s + s_l)/ds over the interval
+                vec3 a = sigma_t * slope * ds;
+                // ∫ e^{−σ(g_prev + slope (s' − s_prev))} ds' = e^{−σ g_prev}(1 − e^{−σ slope ds})/(σ slope).
+                // (1 − e^{−a})/a, by its series where f32 would cancel.
+                vec3 series = vec3(1.0) - 0.5 * a + a * a / 6.0;
+                vec3 closed = (vec3(1.0) - exp(-a)) / mix(vec3(1.0), a, notEqual(a, vec3(0.0)));
+                vec3 part = exp(-sigma_t * g_prev) * ds * mix(series, closed, step(vec3(1e-3), abs(a)));
+                along += (inside && inside_prev ? 1.0 : 0.5) * part * beam;
+            }
+            g_prev = g;
+            s_prev = s;
+            inside_prev = inside;
+        }
+        sum += along;
+    }
+    float ft_o = fresnel_transmittance(eta, cos_o);
+    return ft_o / (eta * eta) * sigma_s * (1.0 / (4.0 * 3.14159265358979323846)) * sum;
+}
+
 void main() {
     ivec2 pixel = ivec2(gl_FragCoord.xy);
     vec4 surface = imageLoad(surface_position, pixel);
@@ -366,7 +463,11 @@ void main() {
     float cos_o = max(dot(no, wo), 0.0);
     vec3 lo = fresnel_transmittance(object_params.channels[0].eta, cos_o) * sum;
     // The Monte Carlo table's exit distribution (the others' lobe is Ft alone).
-    if (MODEL == MODEL_MC) lo *= table_exit_factor(dipole_table, own_cos_t(xo, no), cos_o);
+    if (MODEL == MODEL_MC) {
+        lo *= table_exit_factor(dipole_table, own_cos_t(xo, no), cos_o);
+        // Single scattering, once (by the first of several brute-force draws, as the lobe).
+        if (pc.point_range.x == 0u) lo += single_scattering(xo, no, wo);
+    }
     // The lobe is added once: by the first of several brute-force draws.
     if (frame_params.specular != 0u && pc.point_range.x == 0u) lo += specular(xo, no, wo);
     radiance = vec4(lo, 1.0);

@@ -57,6 +57,7 @@ macro_rules! shade_inputs {
             lights: &o.hierarchy.shadows.lights,
             shadow_map: &o.hierarchy.shadows.shadow_map,
             shadow_sampler: &o.hierarchy.shadows.shadow_sampler,
+            depth_sampler: &o.hierarchy.shadows.depth_sampler,
             point_lights: &o.hierarchy.sorted_point_lights,
             point_flux: &o.hierarchy.sorted_point_flux,
             node_flux: &o.hierarchy.node_flux,

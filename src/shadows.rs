@@ -16,6 +16,9 @@ pub struct Shadows {
     pub lights: Buffer,
     pub shadow_map: Image,
     pub shadow_sampler: Sampler,
+    /// Nearest, no comparison: the depth itself (the Monte Carlo table's single scattering
+    /// measures how far light travels inside from it).
+    pub depth_sampler: Sampler,
     pub(crate) layer_matrices: Vec<Mat4>,
     /// The box of the other objects that may cast shadows on the receiver (see `set_casters`).
     casters: Option<(Vec3, Vec3)>,
@@ -50,6 +53,7 @@ impl Shadows {
                 ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | ImageUsageFlags::SAMPLED,
             )?,
             shadow_sampler: Sampler::new(ctx, true, true)?,
+            depth_sampler: Sampler::new(ctx, false, false)?,
             layer_matrices: Vec::new(),
             casters: None,
             eta,

@@ -1,6 +1,9 @@
 //! The Monte Carlo table (`--model mc`, src/physics/mc_profile.rs) against Chandrasekhar's exact
 //! half-space where the index matches (η = 1): its escape fraction, its incidence factor and its
-//! exit factor, each within the Monte Carlo's own noise. No GPU. (Its render of a thick slab is
+//! exit factor, each within the Monte Carlo's own noise. The table holds two or more scatterings
+//! (the shade pass adds the first): the closed forms less their first order, which at η = 1 is
+//! (ϖ/2)(1 − μ0 ln(1 + 1/μ0)) of the light entering, and radiance ϖ/(4π(μ + μ0)) per unit
+//! irradiance. No GPU. (Its render of a thick slab is
 //! tests/subsurface.rs; against the path tracer, tests/ground_truth.rs.)
 
 use translucent::physics::halfspace::{h_function, index_matched_plane_albedo};
@@ -12,15 +15,31 @@ fn matched(albedo: f64) -> McProfile {
     (*McProfile::of(&Medium { sigma_a: 1.0 - albedo, sigma_s: albedo, g: 0.0, eta: 1.0 })).clone()
 }
 
-/// Escape at normal incidence: 1 − H(1)√(1 − ϖ); at each incidence node μ0 (= cos θt at η = 1)
-/// the factor f = (1 − H(μ0)√(1 − ϖ)) / (1 − H(1)√(1 − ϖ)). Within 4σ of the escapes counted.
+/// Orders ≥ 2 of the plane albedo at incidence μ0: 1 − H(μ0)√(1 − ϖ) − (ϖ/2)(1 − μ0 ln(1 + 1/μ0)).
+fn multiple(albedo: f64, mu0: f64) -> f64 {
+    index_matched_plane_albedo(albedo, mu0) - single(albedo, mu0)
+}
+
+/// The first order: 2π∫ ϖ/(4π(μ + μ0)) μ dμ = (ϖ/2)(1 − μ0 ln(1 + 1/μ0)).
+fn single(albedo: f64, mu0: f64) -> f64 {
+    0.5 * albedo * (1.0 - mu0 * (1.0 + 1.0 / mu0).ln())
+}
+
+/// Escape at normal incidence (orders ≥ 2, and the first order apart); at each incidence node μ0
+/// (= cos θt at η = 1) the factor f = multiple(μ0) / multiple(1). Within 4σ of the escapes counted.
 #[test]
 fn escape_and_incidence_factor_match_chandrasekhar() {
     for albedo in [0.5, 0.9, 0.99] {
         let p = matched(albedo);
-        let exact = index_matched_plane_albedo(albedo, 1.0);
+        let exact = multiple(albedo, 1.0);
         let sigma = |escapes: u64| 1.0 / (escapes as f64).sqrt();
-        println!("ϖ {albedo}: escape {:.5} vs {exact:.5}", p.escape);
+        let first = single(albedo, 1.0);
+        println!("ϖ {albedo}: escape {:.5} vs {exact:.5}, single {:.5} vs {first:.5}", p.escape, p.single_escape);
+        assert!(
+            (p.single_escape / first - 1.0).abs() < 4.0 * sigma(mc_profile::ESCAPES_NORMAL) / first.sqrt(),
+            "ϖ {albedo}: single {} vs {first}",
+            p.single_escape
+        );
         assert!(
             (p.escape / exact - 1.0).abs() < 4.0 * sigma(mc_profile::ESCAPES_NORMAL),
             "ϖ {albedo}: {} vs {exact}",
@@ -28,7 +47,7 @@ fn escape_and_incidence_factor_match_chandrasekhar() {
         );
         for k in 0..INCIDENCE_NODES - 1 {
             let mu0 = mc_profile::incidence_node(p.cos_t_min, k);
-            let expected = index_matched_plane_albedo(albedo, mu0) / exact;
+            let expected = multiple(albedo, mu0) / exact;
             let tolerance = 4.0 * sigma(mc_profile::ESCAPES_OBLIQUE) + 4.0 * sigma(mc_profile::ESCAPES_NORMAL);
             println!("  μ0 {mu0:.3}: f {:.4} vs {expected:.4}", p.incidence[k]);
             assert!(
@@ -40,9 +59,9 @@ fn escape_and_incidence_factor_match_chandrasekhar() {
     }
 }
 
-/// The exit factor against Chandrasekhar's reflection function: radiance per unit irradiance
-/// L(μ) = ϖ H(μ) H(μ0) / (4π(μ + μ0)), over the lobe the renderer puts on the escaping light
-/// (Ft = 1 and ∫Ft cos θ dω = π at η = 1): h = L·π / escape, averaged over each bin of cos²θo;
+/// The exit factor against Chandrasekhar's reflection function less its first order: radiance per
+/// unit irradiance L(μ) = ϖ (H(μ) H(μ0) − 1) / (4π(μ + μ0)), over the lobe the renderer puts on
+/// the escaping light (Ft = 1 and ∫Ft cos θ dω = π at η = 1): h = L·π / escape, averaged over each bin of cos²θo;
 /// at normal incidence and at the most grazing node. Within 4σ of the bin's count.
 #[test]
 fn exit_factor_matches_chandrasekhar() {
@@ -50,14 +69,14 @@ fn exit_factor_matches_chandrasekhar() {
     let p = matched(albedo);
     for (k, escapes) in [(INCIDENCE_NODES - 1, mc_profile::ESCAPES_NORMAL), (0, mc_profile::ESCAPES_OBLIQUE)] {
         let mu0 = mc_profile::incidence_node(p.cos_t_min, k);
-        let escape = index_matched_plane_albedo(albedo, mu0);
+        let escape = multiple(albedo, mu0);
         let h0 = h_function(albedo, mu0);
         for b in 0..EXIT_BINS {
             let sub = 16;
             let expected = (0..sub)
                 .map(|j| {
                     let mu = ((b as f64 + (j as f64 + 0.5) / sub as f64) / EXIT_BINS as f64).sqrt();
-                    albedo * h_function(albedo, mu) * h0 / (4.0 * (mu + mu0)) / escape
+                    albedo * (h_function(albedo, mu) * h0 - 1.0) / (4.0 * (mu + mu0)) / escape
                 })
                 .sum::<f64>()
                 / sub as f64;

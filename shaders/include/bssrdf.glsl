@@ -23,8 +23,8 @@ struct BssrdfChannel {
     float zr;
     float zv;
     float transports;
-    float pad0;
-    float pad1;
+    float sigma_s_reduced;
+    float sigma_t_reduced;
 };
 
 // Unpolarised Fresnel reflectance for relative index eta, cos_i to the normal; 1 under total

@@ -27,7 +27,9 @@ pub struct GpuChannel {
     pub zv: f32,
     /// 1 where diffusion applies, 0 for a pure-absorber channel.
     pub transports: f32,
-    pub _pad: [f32; 2],
+    /// σ's and σ't: the Monte Carlo table's single scattering (the similarity relation).
+    pub sigma_s_reduced: f32,
+    pub sigma_t_reduced: f32,
 }
 
 impl From<&ChannelConstants> for GpuChannel {
@@ -49,7 +51,8 @@ impl From<&ChannelConstants> for GpuChannel {
             zr: c.zr as f32,
             zv: c.zv as f32,
             transports: if c.transports { 1.0 } else { 0.0 },
-            _pad: [0.0; 2],
+            sigma_s_reduced: c.sigma_s_reduced as f32,
+            sigma_t_reduced: c.sigma_t_reduced as f32,
         }
     }
 }

@@ -47,6 +47,8 @@ pub struct ShadeInputs<'a> {
     pub lights: &'a Buffer,
     pub shadow_map: &'a Image,
     pub shadow_sampler: &'a Sampler,
+    /// The shadow map's depth, unfiltered (single scattering).
+    pub depth_sampler: &'a Sampler,
     /// Each light's own record of each point (brute force only).
     pub point_lights: &'a Buffer,
     pub point_flux: &'a Buffer,
@@ -255,6 +257,7 @@ impl ShadePass {
             Bind::Uniform(inputs.frame_params),
             Bind::Texels(inputs.point_flux),
             Bind::Texels(inputs.point_spread),
+            Bind::Sampled(inputs.shadow_map, inputs.depth_sampler),
         ];
         let mut c = *constants;
         c.point_range = glam::UVec4::new(unit.first_point, unit.point_count, unit.object, 0);

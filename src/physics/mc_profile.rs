@@ -1,11 +1,14 @@
-//! The half-space's exact transport, tabulated by Monte Carlo (`--model mc`): a separable BSSRDF
-//! S = Ft(θi) f(θt) · Sp(r) · h(θo) Ft(θo) whose parts are measured, per channel, by the analogue
-//! Monte Carlo of [`super::halfspace::trace_half_space`] (which reproduces Mitsuba 3's
-//! path-traced thick slabs within 0.5%, tests/halfspace.rs) instead of derived from diffusion:
+//! The half-space's exact transport, tabulated by Monte Carlo (`--model mc`): multiple scattering
+//! (two or more scatterings) as a separable BSSRDF S = Ft(θi) f(θt) · Sp(r) · h(θt, θo) Ft(θo)
+//! whose parts are measured, per channel, by the analogue Monte Carlo of
+//! [`super::halfspace::trace_half_space`] (which reproduces Mitsuba 3's path-traced thick slabs
+//! within 0.5%, tests/halfspace.rs) instead of derived from diffusion, and single scattering
+//! computed by the shade pass along the refracted view ray through the object itself (Jensen et
+//! al. 2001 §3, the light's path inside from its shadow map's depth):
 //!
-//! - Sp(r): the radial exitance profile M(r) of a beam at normal incidence (every order of
-//!   scattering, single scattering included), per unit power entering, as pbrt's separable
-//!   BSSRDF spreads it: Sd = M / ∫Ft cos θ dω (src/physics/beam_diffusion.rs's notes);
+//! - Sp(r): the radial exitance profile M(r) of a beam at normal incidence (orders ≥ 2), per unit
+//!   power entering, as pbrt's separable BSSRDF spreads it: Sd = M / ∫Ft cos θ dω
+//!   (src/physics/beam_diffusion.rs's notes);
 //! - f(θt): how much more (or less) of the light entering along the refracted direction θt
 //!   leaves than at normal incidence, P(θt)/P(0): grazing light enters shallower and more of it
 //!   returns, which a radial profile alone cannot know (the directional dipole's motivation);
@@ -18,7 +21,8 @@
 //! Like pbrt-v4's `TabulatedBSSRDF` it is a table of the semi-infinite medium (Christensen and
 //! Burley 2015 fit such Monte Carlo profiles; here they are used as measured); it is exact on a
 //! flat, thick medium lit at any angle (in total and exit distribution) and at normal incidence
-//! (in profile). It knows neither thickness nor curvature.
+//! (in profile). Its multiple scattering knows neither thickness nor curvature; its single
+//! scattering sees both.
 //!
 //! Scattering is isotropic with the reduced coefficients (the similarity relation), as in the
 //! half-space yardstick. Lengths are in mm; the Monte Carlo works in mean free paths 1/σ't.
@@ -78,9 +82,12 @@ pub struct McProfile {
     pub eta: f64,
     /// ∫Ft cos θ dω over the outer hemisphere (Sd = M / this).
     pub exit_norm: f64,
-    /// The fraction of the power entering at normal incidence that leaves (the boundary's
-    /// reflection of the beam excluded): ∫M dA.
+    /// The fraction of the power entering at normal incidence that leaves after two or more
+    /// scatterings (the table's part; single scattering is the shade pass's): ∫M dA.
     pub escape: f64,
+    /// The fraction that leaves after exactly one (what the shade pass's single scattering
+    /// computes on the flat half-space).
+    pub single_escape: f64,
     /// Exitance M per unit power entering, per mean free path², in each radial bin (bin 0 the disc).
     pub density: Vec<f64>,
     /// cos θt of incidence node 0 ([`critical_cos_t`]).
@@ -156,6 +163,7 @@ impl McProfile {
         // Per incidence node: photons traced, escapes per exit bin. The last node (normal
         // incidence) also gives the radial profile.
         let mut runs = [(0u64, [0u64; EXIT_BINS]); INCIDENCE_NODES];
+        let mut single = 0u64;
         for (k, (traced, exit_counts)) in runs.iter_mut().enumerate() {
             let cos_t = incidence_node(cos_t_min, k);
             let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
@@ -163,6 +171,10 @@ impl McProfile {
             let seed = 0x5eed_0000_0000 + ((k as u64) << 32);
             *traced = if k == INCIDENCE_NODES - 1 {
                 trace_until(albedo, eta, start, (ESCAPES_NORMAL, MAX_PHOTONS_NORMAL), seed, |e| {
+                    if e.scatterings == 1 {
+                        single += 1;
+                        return;
+                    }
                     if let Some(k) = bin_of((e.x * e.x + e.y * e.y).sqrt()) {
                         density[k] += 1.0;
                     }
@@ -170,7 +182,9 @@ impl McProfile {
                 })
             } else {
                 trace_until(albedo, eta, start, (ESCAPES_OBLIQUE, MAX_PHOTONS_OBLIQUE), seed, |e| {
-                    exit_counts[exit_bin(e)] += 1;
+                    if e.scatterings >= 2 {
+                        exit_counts[exit_bin(e)] += 1;
+                    }
                 })
             };
         }
@@ -181,6 +195,7 @@ impl McProfile {
             *d /= normal_traced as f64 * PI * (hi * hi - lo * lo);
         }
         let escape = escape_of(&runs[INCIDENCE_NODES - 1]);
+        let single_escape = single as f64 / normal_traced as f64;
         let incidence = std::array::from_fn(|k| if escape > 0.0 { escape_of(&runs[k]) / escape } else { 1.0 });
         let exit_norm = super::beam_diffusion::exit_normalisation(eta);
         // h per bin: the measured radiance per unit exitance over the renderer's Ft(θo)/exit_norm,
@@ -214,6 +229,7 @@ impl McProfile {
             eta,
             exit_norm,
             escape,
+            single_escape,
             density,
             cos_t_min,
             incidence,
