@@ -116,7 +116,9 @@ mod tests {
         assert_eq!(Model::from_name("beam-diffusion"), Some(Model::Pbd));
         assert_eq!(Model::Directional.next(), Model::Dipole);
         assert_eq!(Model::Dipole.next(), Model::Pbd);
-        assert_eq!(Model::Pbd.next(), Model::Directional);
+        assert_eq!(Model::Pbd.next(), Model::Mc);
+        assert_eq!(Model::Mc.next(), Model::Directional);
+        assert_eq!(Model::from_name("monte-carlo"), Some(Model::Mc));
         assert_eq!(Model::names(), "directional, dipole, pbd or mc");
     }
 }
