@@ -16,6 +16,7 @@
 #include "points.glsl"
 #include "shading_params.glsl"
 #define LIGHTS_BINDING 4
+#define SHADOW_MAP_BINDING 5
 #include "lights.glsl"
 #include "microfacet.glsl"
 #include "tile_lists.glsl"
@@ -37,7 +38,6 @@ layout(binding = 2) uniform usamplerBuffer points;
 // One record per translucent object, indexed by the object shaded.
 struct WorkCounters { uint pixels; uint node_sum; uint node_max; uint point_sum; uint point_max; uint evaluation_sum; };
 layout(std430, binding = 3) buffer Work { WorkCounters objects[]; } work;
-layout(binding = 5) uniform sampler2DArrayShadow shadow_map;
 // Light records as texels: PointLight (sorted, brute force only), NodeFlux.
 layout(binding = 6) uniform usamplerBuffer point_lights;
 layout(binding = 7) uniform usamplerBuffer node_flux;
@@ -68,6 +68,29 @@ const uint EVALUATION_MASK = 0x1fu;
 // Steps of the walk (tests of nodes and points, and evaluations) before it stops opening nodes:
 // llvmpipe's loop budget.
 const uint MAX_STEPS = 32768u;
+
+// The near field (see near_field()): the pixel's own irradiance and flux, merged over the lights
+// (set in main when the frame splits it off; own_lit false where the pixel is unlit).
+vec3 own_irradiance;
+vec4 own_incident[3];
+bool own_lit = false;
+// The control variate's sum (near_correction()), and how far the surface within reach bends away
+// from the pixel's tangent plane: Σ (1 − w) A (1 − ni·no) and Σ (1 − w) A.
+vec3 near_sum = vec3(0.0);
+float near_bend = 0.0, near_area = 0.0;
+// Where the surface within reach bends (mean 1 − ni·no) past NEAR_BEND_START, the tangent plane
+// stands for it less well (at a box's edge the folded face lies nearer in 3D than the plane
+// unfolded, and the plane integral then undershoots by up to 15%), so the control variate fades
+// out, fully at NEAR_BEND_END: such pixels keep the plain point sum. A sphere of 5 mm radius
+// bends about 0.01 within four spacings of 0.28 mm.
+const float NEAR_BEND_START = 0.02;
+const float NEAR_BEND_END = 0.08;
+
+// The near field's weight 1 − w(r) of a place xi seen from xo: 1 within near_start_mm, falling
+// smoothly (smoothstep) to 0 at near_end_mm (ObjectParams).
+float near_weight(vec3 xi, vec3 xo) {
+    return 1.0 - smoothstep(object_params.near_start_mm, object_params.near_end_mm, length(xo - xi) * object_params.mm_per_unit);
+}
 
 vec3 source(vec3 xi, vec3 ni, vec3 wi, vec3 power, vec3 xo, vec3 no) {
     float s = object_params.mm_per_unit;
@@ -113,6 +136,108 @@ vec3 merged_source(vec3 xi, vec3 ni, vec3 power, vec4 incident[3], vec3 dw, vec3
     return sd * power * (s * s); // power is irradiance × scene-unit area: to mm²
 }
 
+// The near field's control variate at a source of `area` (scene units²) at xi, ni, whether lit
+// or not: −(1 − w) times that area lit by the pixel's own irradiance and lights (see
+// near_field()); `made` counts the evaluations.
+// Adds to near_sum and the bend's sums.
+void near_correction(vec3 xi, vec3 ni, float area, vec3 xo, vec3 no, inout uint made) {
+    if (!own_lit) return;
+    float v = near_weight(xi, xo);
+    if (v <= 0.0) return;
+    ++made;
+    vec4 flux[3];
+    for (uint c = 0u; c < 3u; ++c) flux[c] = own_incident[c] * (v * area);
+    // At the pixel's normal, as the plane integral has it: the pixel's lights refracted at ni
+    // would make a different function (near a terminator, lights below ni's horizon).
+    near_sum -= merged_source(xi, no, own_irradiance * (v * area), flux, vec3(0.0), xo, no);
+    near_area += v * area;
+    near_bend += v * area * max(1.0 - dot(ni, no), 0.0);
+}
+
+// The near field. The few points nearest a pixel sample the BSSRDF's peak at r → 0 badly (the
+// default spacing leaves a few percent of noise per pixel, and a moiré of the sample pattern on
+// flat parts), so the sum over sources near xo uses a control variate: the pixel's own
+// irradiance E(xo) (every light's, merged into one PointFlux-style record at xo exactly as the
+// irradiance pass does per point: light_irradiance() in lights.glsl) as if it lit the whole
+// tangent plane,
+//   Lo = Σ_i Sd_i E_i A_i − E(xo) Σ_i (1 − w_i) Sd_i(xo's lights) A_i + E(xo) ∫(1 − w) Sd dA,
+// with 1 − w (near_weight()) falling smoothly from 1 within one point spacing to 0 at four. The
+// middle sum (near_correction(), every source within reach, lit or not) is what the points make
+// of the last term, so the two cancel but for the points' error in it: what remains sampled is
+// Sd · (E_i − E(xo)), which vanishes at the peak where E is smooth, and is the plain point sum
+// where it is not (shadow edges, terminators), so brute force's expectation is kept everywhere.
+// The integral is a fixed quadrature over the disk (this function). Radially: Gauss–Legendre on
+// [0, start] in t, r = scale · sinh t (r dr = scale² sinh t cosh t dt: smooth where Sd peaks
+// over ~D, and where Sd ~ 1/r for beam diffusion's single scattering), and on [start, end],
+// where 1 − w falls smoothly to 0. Angularly (the directional dipole only; the tables are
+// radial): NEAR_ANGLES angles on the half circle from the lights' mean tangential direction,
+// each standing for its mirror image too (the source is symmetric about the plane of the normal
+// and the refracted light). The quadrature's error against a fine f64 grid: within 0.015%
+// (Skin1, light at 0-80°). Returns the evaluations made (`made`).
+const float NEAR_INNER_X[6] = float[](0.033765243, 0.169395307, 0.380690407, 0.619309593, 0.830604693, 0.966234757);
+const float NEAR_INNER_W[6] = float[](0.085662246, 0.180380787, 0.233956967, 0.233956967, 0.180380787, 0.085662246);
+const float NEAR_OUTER_X[4] = float[](0.069431844, 0.330009478, 0.669990522, 0.930568156);
+const float NEAR_OUTER_W[4] = float[](0.173927423, 0.326072577, 0.326072577, 0.173927423);
+const uint NEAR_ANGLES = 4u;
+// The pixel's own irradiance and flux (own_irradiance, own_incident, own_lit).
+void own_light(vec3 xo, vec3 no) {
+    own_irradiance = vec3(0.0);
+    own_incident[0] = own_incident[1] = own_incident[2] = vec4(0.0);
+    for (uint k = 0u; k < light_set.light_count; ++k) {
+        vec3 toward;
+        vec3 e = light_irradiance(light_of(k), xo, no, toward);
+        if (e == vec3(0.0)) continue;
+        vec4 term = flux_term(toward, no);
+        // As the irradiance pass weighs each point's (1 but for the Monte Carlo table).
+        e *= table_incidence_factor(dipole_table, term.w);
+        for (uint c = 0u; c < 3u; ++c) own_incident[c] += e[c] * term;
+        own_irradiance += e;
+    }
+    own_lit = own_irradiance != vec3(0.0);
+}
+
+vec3 near_field(vec3 xo, vec3 no, out uint made) {
+    made = 0u;
+    if (!own_lit) return vec3(0.0);
+    vec3 e = own_irradiance;
+    vec4 incident[3] = own_incident;
+    vec3 toward_mean = incident[0].xyz * 0.2126 + incident[1].xyz * 0.7152 + incident[2].xyz * 0.0722;
+    float s = object_params.mm_per_unit;
+    float start = object_params.near_start_mm, end = object_params.near_end_mm, scale = object_params.near_scale_mm;
+    // The tangent frame: t1 along the lights' mean direction projected onto the plane.
+    vec3 tangential = toward_mean - dot(toward_mean, no) * no;
+    vec3 t1 = dot(tangential, tangential) > 1e-12 * dot(toward_mean, toward_mean)
+        ? normalize(tangential)
+        : normalize(cross(no, abs(no.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0)));
+    vec3 t2 = cross(no, t1);
+    uint angles = MODEL == MODEL_DIRECTIONAL ? NEAR_ANGLES : 1u;
+    float t_end = asinh(start / scale);
+    vec3 sum = vec3(0.0);
+    for (uint j = 0u; j < 10u; ++j) {
+        // r and its weight r dr (1 − w included), in mm and mm².
+        float r, weight;
+        if (j < 6u) {
+            float t = t_end * NEAR_INNER_X[j];
+            r = scale * sinh(t);
+            weight = r * scale * cosh(t) * t_end * NEAR_INNER_W[j];
+        } else {
+            r = start + (end - start) * NEAR_OUTER_X[j - 6u];
+            weight = r * (end - start) * NEAR_OUTER_W[j - 6u] * (1.0 - smoothstep(start, end, r));
+        }
+        // Each angle stands for 2π / angles of the circle; in scene units² for merged_source.
+        float area = weight * (6.28318530718 / float(angles)) / (s * s);
+        vec4 flux[3];
+        for (uint c = 0u; c < 3u; ++c) flux[c] = incident[c] * area;
+        for (uint a = 0u; a < angles; ++a) {
+            float phi = (float(a) + 0.5) * (3.14159265359 / float(angles));
+            vec3 xi = xo + (r / s) * (cos(phi) * t1 + sin(phi) * t2);
+            sum += merged_source(xi, no, e * area, flux, vec3(0.0), xo, no);
+        }
+        made += angles;
+    }
+    return sum;
+}
+
 // One light's record of one point (brute force): record = point · light_count + light.
 vec3 point_light_source(uint record, uint light_count, vec3 xo, vec3 no) {
     uvec4 l = texel(point_lights, record);
@@ -125,9 +250,10 @@ vec3 point_light_source(uint record, uint light_count, vec3 xo, vec3 no) {
 }
 
 // Point `index` as a merged source: its position, power and flux (times its area).
-void point_source(uint index, out vec3 xi, out vec3 power, out vec4 incident[3]) {
+void point_source(uint index, out vec3 xi, out vec3 power, out vec4 incident[3], out float area) {
     vec4 position_area = texel_float(points, index * POINT_TEXELS);
     xi = position_area.xyz;
+    area = position_area.w;
     power = texel_float(points, index * POINT_TEXELS + 2u).xyz * position_area.w;
     for (uint c = 0u; c < 3u; ++c) incident[c] = texel_float(point_flux, index * POINT_FLUX_TEXELS + c) * position_area.w;
 }
@@ -160,9 +286,13 @@ vec3 point_evaluated(uint index, vec3 xi, vec3 ni, vec3 power, vec4 incident[3],
 // underestimates it (1-1.5% on a slab). Two sigma points c ± s(u + t), s² = spread²/2 per axis of
 // the node's tangent plane (u toward xo, t across), match the points' mean and second moments, so
 // Sd's curvature along u and t is taken into account to second order.
-void node_sigma(uint index, vec3 ni, vec3 xo, out vec3 center, out vec3 offset, out vec3 power, out vec4 incident[3]) {
+// `area`: half the node's (an unlit node's sigma points are both at its centre).
+void node_sigma(uint index, vec3 ni, vec3 xo, out vec3 center, out vec3 offset, out vec3 power, out vec4 incident[3],
+                out float area) {
     uint record = index * NODE_FLUX_TEXELS;
-    power = 0.5 * texel_float(nodes, index * NODE_TEXELS).xyz;
+    vec4 power_area = texel_float(nodes, index * NODE_TEXELS);
+    power = 0.5 * power_area.xyz;
+    area = 0.5 * power_area.w;
     for (uint c = 0u; c < 3u; ++c) incident[c] = 0.5 * texel_float(node_flux, record + c);
     vec4 center_spread = texel_float(node_flux, record + 3u);
     center = center_spread.xyz;
@@ -170,6 +300,12 @@ void node_sigma(uint index, vec3 ni, vec3 xo, out vec3 center, out vec3 offset, 
     vec3 u = towards_xo - ni * dot(towards_xo, ni);
     u = dot(u, u) > 0.0 ? normalize(u) : normalize(cross(ni, abs(ni.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0)));
     offset = sqrt(0.5 * center_spread.w) * (u + cross(ni, u));
+}
+
+// Whether the box [lo, hi] (scene units) reaches within the near field's end of xo.
+bool within_near_reach(vec3 xo, vec3 lo, vec3 hi) {
+    vec3 d = max(max(lo - xo, xo - hi), vec3(0.0)) * object_params.mm_per_unit;
+    return dot(d, d) < object_params.near_end_mm * object_params.near_end_mm;
 }
 
 uint tile_entry(uint i) { return texel(tile_entries, i >> 2)[i & 3u]; }
@@ -183,10 +319,7 @@ vec3 specular(vec3 xo, vec3 no, vec3 wo) {
         vec3 incident = light_at(light_of(k), xo, toward, layer);
         float f_cos = microfacet_reflect_cos(no, toward, wo, frame_params.roughness, object_params.channels[0].eta);
         if (f_cos <= 0.0) continue;
-        vec4 clip = layer_matrix(layer) * vec4(xo + no * light_set.normal_offset, 1.0);
-        vec3 ndc = clip.xyz / clip.w;
-        float visibility = texture(shadow_map, vec4(ndc.xy * 0.5 + 0.5, float(layer), ndc.z));
-        sum += f_cos * incident * visibility;
+        sum += f_cos * incident * shadow_visibility(layer, xo, no);
     }
     return sum;
 }
@@ -324,14 +457,25 @@ void main() {
     uint evaluated = 0u;
     uint evaluations = 0u;
     uint light_count = light_set.light_count;
+    if (frame_params.near_field != 0u) own_light(xo, no);
     if (frame_params.brute_force != 0u || object_params.node_count == 0u) {
         // One draw per range of (point, light) records, added by blending: llvmpipe (lavapipe)
         // silently ends a shader invocation's loops after ~65k iterations in total, so no draw
         // may loop longer.
         uint end = min(pc.point_range.x + pc.point_range.y, object_params.point_count * light_count);
-        for (uint r = pc.point_range.x; r < end; ++r) sum += point_light_source(r, light_count, xo, no);
+        uint corrections = 0u;
+        for (uint r = pc.point_range.x; r < end; ++r) {
+            sum += point_light_source(r, light_count, xo, no);
+            // The near field's control variate, once per point (with --near-field on).
+            if (own_lit && r % light_count == 0u) {
+                uint point = r / light_count;
+                vec4 position_area = texel_float(points, point * POINT_TEXELS);
+                vec3 ni = texel_float(points, point * POINT_TEXELS + 1u).xyz;
+                near_correction(position_area.xyz, ni, position_area.w, xo, no, corrections);
+            }
+        }
         evaluated = end > pc.point_range.x ? end - pc.point_range.x : 0u;
-        evaluations = evaluated;
+        evaluations = evaluated + corrections;
     } else {
         // The tile's list (tile_cut.comp): every lane of the tile runs the same evaluations in
         // the same order, one loop iteration each, so the lanes of a SIMD group or warp stay
@@ -343,9 +487,12 @@ void main() {
             uint index = tile_entry(entry + e);
             vec3 xi, power;
             vec4 incident[3];
-            point_source(index, xi, power, incident);
-            if (power == vec3(0.0)) continue;
+            float area;
+            point_source(index, xi, power, incident, area);
             vec3 ni = texel_float(points, index * POINT_TEXELS + 1u).xyz;
+            // Unlit points are listed only within the near field's reach, for its control variate.
+            near_correction(xi, ni, area, xo, no, evaluations);
+            if (power == vec3(0.0)) continue;
             uint made;
             sum += point_evaluated(index, xi, ni, power, incident, xo, no, made);
             evaluations += made;
@@ -358,7 +505,10 @@ void main() {
             vec3 ni = decode_oct(texel(nodes, index * NODE_TEXELS + 3u).x);
             vec3 center, offset, power;
             vec4 incident[3];
-            node_sigma(index, ni, xo, center, offset, power, incident);
+            float area;
+            node_sigma(index, ni, xo, center, offset, power, incident, area);
+            near_correction(center + offset, ni, area, xo, no, evaluations);
+            near_correction(center - offset, ni, area, xo, no, evaluations);
             if (power == vec3(0.0)) continue;
             evaluations += 2u;
             sum += merged_source(center + offset, ni, power, incident, vec3(0.0), xo, no)
@@ -394,7 +544,10 @@ void main() {
                     ni = texel_float(points, index * POINT_TEXELS + 1u).xyz;
                     if (next == 0u) {
                         ++evaluated;
-                        if (texel_float(points, index * POINT_TEXELS + 2u).xyz == vec3(0.0)) continue;
+                        // Unlit: only the near field's control variate needs it.
+                        if (texel_float(points, index * POINT_TEXELS + 2u).xyz == vec3(0.0)
+                            && !(own_lit && near_weight(texel_float(points, index * POINT_TEXELS).xyz, xo) > 0.0))
+                            continue;
                     }
                 } else {
                     // A continuation needs only the node's normal: the rest is loaded on its first visit.
@@ -404,9 +557,10 @@ void main() {
                         uvec4 center_left = texel(nodes, index * NODE_TEXELS + 1u);
                         uvec4 box_right = texel(nodes, index * NODE_TEXELS + 2u);
                         ++visits;
-                        if (power_area.xyz == vec3(0.0)) continue;
                         vec3 lo, hi;
                         unpack_box(box_right.xyz, lo, hi);
+                        // Unlit: only the near field's control variate needs it, within its reach.
+                        if (power_area.xyz == vec3(0.0) && !(own_lit && within_near_reach(xo, lo, hi))) continue;
                         vec3 d = uintBitsToFloat(center_left.xyz) - xo;
                         bool inside = all(greaterThanEqual(xo, lo)) && all(lessThanEqual(xo, hi));
                         // A full stack or a spent step budget (see above) ends the descent: the
@@ -427,12 +581,14 @@ void main() {
                 if (!is_point && evaluation == 0u) stack[top++] = item | (2u << EVALUATION_SHIFT);
                 vec3 xi, offset, power;
                 vec4 incident[3];
+                float area;
                 if (is_point) {
-                    point_source(index, xi, power, incident);
+                    point_source(index, xi, power, incident, area);
                 } else {
-                    node_sigma(index, ni, xo, xi, offset, power, incident);
+                    node_sigma(index, ni, xo, xi, offset, power, incident, area);
                     xi += evaluation != 0u ? -offset : offset;
                 }
+                near_correction(xi, ni, area, xo, no, evaluations);
                 if (power == vec3(0.0)) continue;
                 if (is_point) {
                     uint made;
@@ -444,6 +600,17 @@ void main() {
                 }
             }
         }
+    }
+    // The near field, once: by the first of several brute-force draws.
+    if (frame_params.near_field != 0u) {
+        uint made = 0u;
+        vec3 integral = pc.point_range.x == 0u ? near_field(xo, no, made) : vec3(0.0);
+        evaluations += made;
+        // Brute force's draws add up, so none sees the whole bend: there the variate stays whole.
+        bool brute_force = frame_params.brute_force != 0u || object_params.node_count == 0u;
+        float bend = near_area > 0.0 ? near_bend / near_area : 0.0;
+        float keep = brute_force ? 1.0 : 1.0 - smoothstep(NEAR_BEND_START, NEAR_BEND_END, bend);
+        sum += keep * (near_sum + integral);
     }
     // Helper invocations' atomics have no effect (Vulkan spec), so only real pixels count.
     if (frame_params.count_work != 0u) {

@@ -41,6 +41,12 @@ float distance2_to_box(vec3 p, vec3 lo, vec3 hi) {
     return dot(d, d);
 }
 
+// The squared distance between the boxes [lo, hi] and [a, b] (0 where they overlap).
+float box_distance2(vec3 lo, vec3 hi, vec3 a, vec3 b) {
+    vec3 d = max(max(lo - b, a - hi), vec3(0.0));
+    return dot(d, d);
+}
+
 // The subtree after the one whose last point is `last`, in depth-first order (left child
 // first): it starts at point last + 1, and in Karras's layout an internal node's range has the
 // node's own index at one end, so it is internal node last + 1 if that node's range starts
@@ -58,13 +64,18 @@ uint next_after(uint last) {
 uvec3 walk(vec3 tile_lo, vec3 tile_hi, bool write, uint first, uvec3 counts) {
     float tile_extent2 = dot(tile_hi - tile_lo, tile_hi - tile_lo);
     uvec3 n = uvec3(0u);
+    // The near field's reach, in scene units squared (0: no near field this frame).
+    bool near = frame_params.near_field != 0u;
+    float near_end = object_params.near_end_mm / object_params.mm_per_unit;
+    float near_end2 = near_end * near_end;
     uint item = 0u; // the root
     uint steps = 0u;
     while (item != END) {
         ++steps;
         uint index = item & ~LEAF_BIT;
         if ((item & LEAF_BIT) != 0u) {
-            if (texel_float(points, index * POINT_TEXELS + 2u).xyz != vec3(0.0)) {
+            if (texel_float(points, index * POINT_TEXELS + 2u).xyz != vec3(0.0)
+                || (near && distance2_to_box(texel_float(points, index * POINT_TEXELS).xyz, tile_lo, tile_hi) < near_end2)) {
                 if (write) entries[first + n.x] = index;
                 ++n.x;
             }
@@ -74,14 +85,16 @@ uvec3 walk(vec3 tile_lo, vec3 tile_hi, bool write, uint first, uvec3 counts) {
         vec4 power_area = texel_float(nodes, index * NODE_TEXELS);
         uvec4 range = texel(nodes, index * NODE_TEXELS + 3u);
         uint after = next_after(range.z + range.w - 1u);
-        if (power_area.xyz == vec3(0.0)) {
-            item = after;
-            continue;
-        }
         uvec4 center_left = texel(nodes, index * NODE_TEXELS + 1u);
         uvec4 box_right = texel(nodes, index * NODE_TEXELS + 2u);
         vec3 lo, hi;
         unpack_box(box_right.xyz, lo, hi);
+        // Unlit nodes matter only to the near field's control variate (shade.frag), within its
+        // reach of the tile.
+        if (power_area.xyz == vec3(0.0) && !(near && box_distance2(lo, hi, tile_lo, tile_hi) < near_end2)) {
+            item = after;
+            continue;
+        }
         bool overlaps = all(lessThanEqual(lo, tile_hi)) && all(lessThanEqual(tile_lo, hi));
         float d2 = distance2_to_box(uintBitsToFloat(center_left.xyz), tile_lo, tile_hi);
         bool whole = !overlaps && power_area.w < frame_params.epsilon * d2;

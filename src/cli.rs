@@ -199,6 +199,28 @@ impl From<DiffusionArg> for Diffusion {
     }
 }
 
+/// When the near-field split applies (`--near-field`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum NearFieldArg {
+    /// With the tree; brute force stays the exact point sum.
+    Auto,
+    /// Always, brute force too (to see the split's own error).
+    On,
+    /// Never: every source summed at its full weight, however near (the sum before the split).
+    Off,
+}
+
+impl From<NearFieldArg> for crate::frame_desc::NearField {
+    fn from(n: NearFieldArg) -> Self {
+        use crate::frame_desc::NearField;
+        match n {
+            NearFieldArg::Auto => NearField::Auto,
+            NearFieldArg::On => NearField::On,
+            NearFieldArg::Off => NearField::Off,
+        }
+    }
+}
+
 #[derive(Args, Debug)]
 pub struct BssrdfArgs {
     #[arg(long, value_parser = model_arg(), default_value = "directional")]
@@ -384,6 +406,13 @@ pub struct RenderArgs {
     /// Visit every sample point for every pixel (the reference for the tree).
     #[arg(long)]
     pub brute_force: bool,
+    /// The near field: sources within a few point spacings of the pixel are weighted down (to 0
+    /// within one spacing, smoothly up to 1 at four) and the pixel's own irradiance times a fixed
+    /// quadrature of ∫(1 − w) Sd dA over its tangent plane replaces them, since the few nearest
+    /// points sample the BSSRDF's peak badly. `auto`: with the tree, not with --brute-force
+    /// (the exact point sum, the reference).
+    #[arg(long, value_enum, default_value = "auto")]
+    pub near_field: NearFieldArg,
     /// Leave out the surface's own (microfacet) reflection: subsurface scattering alone.
     #[arg(long)]
     pub no_specular: bool,

@@ -524,7 +524,8 @@ impl Renderer {
                 count_work: desc.count_work as u32,
                 specular: desc.specular as u32,
                 roughness: desc.roughness,
-                pad: [0; 3],
+                near_field: integration.splits_near_field() as u32,
+                pad: [0; 2],
             }],
         )?;
         self.generation += 1;

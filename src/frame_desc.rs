@@ -49,6 +49,30 @@ pub struct Integration {
     pub epsilon: f32,
     /// Sum over every point instead of walking the tree (the reference).
     pub brute_force: bool,
+    /// Whether each pixel's sum is split into the near field (the pixel's own irradiance times a
+    /// fixed quadrature of Sd) and the far (the sources, weighted down near the pixel).
+    pub near_field: NearField,
+}
+
+/// When the near-field split applies (see [`Integration::near_field`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum NearField {
+    /// With the tree, not with brute force (which stays the exact point sum: the reference).
+    #[default]
+    Auto,
+    On,
+    Off,
+}
+
+impl Integration {
+    /// Whether this frame splits off the near field.
+    pub fn splits_near_field(&self) -> bool {
+        match self.near_field {
+            NearField::Auto => !self.brute_force,
+            NearField::On => true,
+            NearField::Off => false,
+        }
+    }
 }
 
 impl Default for Integration {
@@ -58,6 +82,7 @@ impl Default for Integration {
             diffusion: Diffusion::Classical,
             epsilon: DEFAULT_EPSILON,
             brute_force: false,
+            near_field: NearField::Auto,
         }
     }
 }

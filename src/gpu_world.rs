@@ -254,7 +254,9 @@ impl GpuWorld {
                     g.hierarchy.set_lights(&mesh, &desc.lights)?;
                 }
             }
+            // The mesh's area sets the points' spacing, and with it the near field's radii.
             let params_changed = remade
+                || mesh_changed
                 || object.material != g.made_from.material
                 || diffusion != g.made_from.diffusion
                 || table != g.made_from.table
@@ -384,14 +386,22 @@ fn upload_mesh(ctx: &Context, mesh: &Mesh) -> Result<(Buffer, Buffer, u32)> {
 /// Writes an object's parameters and its Sd table from what it is made from.
 fn write_params(params: &mut Buffer, table: &mut Buffer, from: &MadeFrom, point_count: u32) -> Result<()> {
     let constants = |c: usize| from.material.channel(c).constants(from.diffusion);
+    let channels = [0, 1, 2].map(|c| GpuChannel::from(&constants(c)));
+    let area_mm2 = from.mesh.surface_area() * from.mm_per_unit * from.mm_per_unit;
+    let spacing_mm = (area_mm2 / point_count.max(1) as f32).sqrt();
+    let (near_start_mm, near_end_mm, near_scale_mm) = ObjectParams::near_field(spacing_mm, &channels);
     params.write(
         0,
         &[ObjectParams {
-            channels: [0, 1, 2].map(|c| GpuChannel::from(&constants(c))),
+            channels,
             mm_per_unit: from.mm_per_unit,
             point_count,
             node_count: point_count - 1,
-            pad: 0,
+            spacing_mm,
+            near_start_mm,
+            near_end_mm,
+            near_scale_mm,
+            pad: 0.0,
         }],
     )?;
     let (sd_table, factors) = match from.table {

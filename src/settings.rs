@@ -220,6 +220,7 @@ impl RenderSettings {
             diffusion: args.diffusion.into(),
             epsilon: args.epsilon,
             brute_force: args.brute_force,
+            near_field: args.near_field.into(),
         };
         (d.width, d.height) = (args.width, args.height);
         (d.specular, d.roughness) = (!args.no_specular, args.roughness);

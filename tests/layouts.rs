@@ -29,6 +29,10 @@ fn shading_params_and_tree_match_glsl() {
             offset_of!(ObjectParams, mm_per_unit),
             offset_of!(ObjectParams, point_count),
             offset_of!(ObjectParams, node_count),
+            offset_of!(ObjectParams, spacing_mm),
+            offset_of!(ObjectParams, near_start_mm),
+            offset_of!(ObjectParams, near_end_mm),
+            offset_of!(ObjectParams, near_scale_mm),
         ]
         .iter()
         .map(|&o| o as u32)
@@ -41,13 +45,14 @@ fn shading_params_and_tree_match_glsl() {
             offset_of!(FrameParams, count_work),
             offset_of!(FrameParams, specular),
             offset_of!(FrameParams, roughness),
+            offset_of!(FrameParams, near_field),
         ]
         .iter()
         .map(|&o| o as u32)
         .collect();
         assert_eq!(frame[..rust.len()], rust[..], "{shader}");
     }
-    assert_eq!(size_of::<ObjectParams>(), 208);
+    assert_eq!(size_of::<ObjectParams>(), 224);
     assert_eq!(size_of::<FrameParams>(), 32);
     let node = member_offsets("hierarchy/tree_aggregate.comp", "TreeNode").expect("TreeNode");
     let rust: Vec<u32> = [

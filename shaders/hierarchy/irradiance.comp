@@ -7,10 +7,10 @@
 #include "points.glsl"
 #include "bssrdf.glsl"
 #define LIGHTS_BINDING 1
+#define SHADOW_MAP_BINDING 2
 #include "lights.glsl"
 layout(local_size_x = 64) in;
 layout(std430, binding = 0) buffer Points { SurfacePoint points[]; };
-layout(binding = 2) uniform sampler2DArrayShadow shadow_map;
 layout(std430, binding = 3) writeonly buffer PointLights { PointLight point_lights[]; };
 layout(std430, binding = 4) writeonly buffer PointFluxes { PointFlux point_flux[]; };
 layout(std430, binding = 5) writeonly buffer PointSpreads { PointSpread point_spread[]; };
@@ -68,28 +68,16 @@ void main() {
     vec3 first = vec3(0.0);
     mat3 second = mat3(0.0);
     for (uint k = 0u; k < light_set.light_count; ++k) {
-        GpuLight light = light_of(k);
         vec3 toward;
-        uint layer;
-        vec3 incident = light_at(light, p.position, toward, layer);
-        float cos_theta = dot(p.normal, toward);
-        uint record = i * light_set.light_count + k;
-        if (pc.per_light_records != 0u) point_lights[record] = PointLight(vec3(0.0), encode_oct(toward));
-        if (cos_theta <= 0.0) continue;
-        // Offset along the normal by a few shadow-map texels so lit surfaces do not shadow themselves.
-        vec4 clip = layer_matrix(layer) * vec4(p.position + p.normal * light_set.normal_offset, 1.0);
-        vec3 ndc = clip.xyz / clip.w;
-        float visibility = texture(shadow_map, vec4(ndc.xy * 0.5 + 0.5, float(layer), ndc.z));
-        // The same direction brute force refracts from the decoded record, so that one light's
-        // merged record is that light's own; cos θt as refract_in computes it.
-        vec3 wi = decode_oct(encode_oct(toward));
-        float cos_i = dot(wi, p.normal);
-        float cos_t = sqrt(max(1.0 - (1.0 - cos_i * cos_i) / (light_set.eta * light_set.eta), 0.0));
-        vec3 e = incident * cos_theta * fresnel_transmittance(light_set.eta, cos_theta) * visibility
-               * table_incidence_factor(sd_table, cos_t);
-        if (pc.per_light_records != 0u) point_lights[record].irradiance = e;
+        // light_irradiance (lights.glsl): the shade pass computes its pixel's own the same way;
+        // the table's incidence factor (1 but for the Monte Carlo table) on top.
+        vec3 e = light_irradiance(light_of(k), p.position, p.normal, toward);
+        vec4 term = flux_term(toward, p.normal);
+        e *= table_incidence_factor(sd_table, term.w);
+        if (pc.per_light_records != 0u) point_lights[i * light_set.light_count + k] = PointLight(e, encode_oct(toward));
         if (e == vec3(0.0)) continue;
-        for (uint c = 0u; c < 3u; ++c) flux.incident[c] += e[c] * vec4(wi, cos_t);
+        vec3 wi = term.xyz;
+        for (uint c = 0u; c < 3u; ++c) flux.incident[c] += e[c] * term;
         float y = dot(e, vec3(0.2126, 0.7152, 0.0722));
         vec3 w12 = refract_in(wi, p.normal, light_set.eta);
         weight += y;

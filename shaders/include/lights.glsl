@@ -74,4 +74,43 @@ vec3 light_at(GpuLight light, vec3 x, out vec3 toward, out uint layer) {
     if (light.spot != 0u) e *= spot_falloff(dot(-toward, light.axis.xyz), light.axis.w, light.cos_falloff_start);
     return e;
 }
+
+// The per-light irradiance that enters the surface, shared by the irradiance pass (per sample
+// point) and the shade pass (the pixel's own, for the near field), so that the two cannot
+// drift apart. Declares the shadow maps at binding SHADOW_MAP_BINDING (defined by the shader
+// before it includes this file, with LIGHTS_BINDING).
+#if defined(LIGHTS_BINDING) && defined(SHADOW_MAP_BINDING)
+#include "bssrdf.glsl"
+#include "points.glsl"
+layout(binding = SHADOW_MAP_BINDING) uniform sampler2DArrayShadow shadow_map;
+
+// The shadow map's visibility of x (normal n) in `layer`, looked up from x offset along the normal
+// by a few shadow-map texels, so that lit surfaces do not shadow themselves.
+float shadow_visibility(uint layer, vec3 x, vec3 n) {
+    vec4 clip = layer_matrix(layer) * vec4(x + n * light_set.normal_offset, 1.0);
+    vec3 ndc = clip.xyz / clip.w;
+    return texture(shadow_map, vec4(ndc.xy * 0.5 + 0.5, float(layer), ndc.z));
+}
+
+// The irradiance `light` sends into the surface at x (normal n): I · max(0, n·l) · Ft(eta, n·l) ·
+// visibility, 0 where it does not reach; `toward` is the unit direction toward it.
+vec3 light_irradiance(GpuLight light, vec3 x, vec3 n, out vec3 toward) {
+    uint layer;
+    vec3 incident = light_at(light, x, toward, layer);
+    float cos_theta = dot(n, toward);
+    if (cos_theta <= 0.0) return vec3(0.0);
+    float visibility = shadow_visibility(layer, x, n);
+    return incident * cos_theta * fresnel_transmittance(light_set.eta, cos_theta) * visibility;
+}
+
+// One light's term per unit irradiance in a merged record (PointFlux) at normal n: the direction
+// toward it as brute force decodes it from its record (so that one light's merged record is that
+// light's own), and the cosine of its refracted direction as refract_in computes it.
+vec4 flux_term(vec3 toward, vec3 n) {
+    vec3 wi = decode_oct(encode_oct(toward));
+    float cos_i = dot(wi, n);
+    float cos_t = sqrt(max(1.0 - (1.0 - cos_i * cos_i) / (light_set.eta * light_set.eta), 0.0));
+    return vec4(wi, cos_t);
+}
+#endif
 #endif

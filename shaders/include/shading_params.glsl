@@ -9,7 +9,15 @@ struct ObjectParams {
     float mm_per_unit;         // scene scale: positions × mm_per_unit = mm
     uint point_count;
     uint node_count;
-    uint pad0;
+    float spacing_mm;          // the sample points' spacing: sqrt(area / point_count), mm
+    // The near field (shade.frag): sources are weighted by w(r), a smoothstep from 0 at
+    // near_start_mm to 1 at near_end_mm, and the pixel's own irradiance times
+    // ∫(1 - w) Sd dA over its tangent plane is added. near_scale_mm is the length the
+    // quadrature's inner radii are graded by (the smallest diffusion coefficient D).
+    float near_start_mm;
+    float near_end_mm;
+    float near_scale_mm;
+    float pad0;
 };
 struct FrameParams {
     float epsilon;             // a node is one source when area / distance² < epsilon
@@ -17,7 +25,7 @@ struct FrameParams {
     uint count_work;           // 1: add this pixel's work to the counters (--profile)
     uint specular;             // 1: add the microfacet lobe (--no-specular: 0)
     float roughness;           // of the microfacet lobe; alpha = roughness²
-    uint pad0;
+    uint near_field;           // 1: split each pixel's sum into the near field and the far (see ObjectParams)
     uint pad1;
     uint pad2;
 };

@@ -66,7 +66,32 @@ pub struct ObjectParams {
     pub mm_per_unit: f32,
     pub point_count: u32,
     pub node_count: u32,
-    pub pad: u32,
+    /// The sample points' spacing, sqrt(area / point count), in mm.
+    pub spacing_mm: f32,
+    /// The near field (shade.frag): every source of the sum is weighted by a smoothstep from 0
+    /// at `near_start_mm` to 1 at `near_end_mm` from the pixel, and the pixel's own irradiance
+    /// times ∫(1 − w) Sd dA over its tangent plane is added (a fixed quadrature).
+    pub near_start_mm: f32,
+    pub near_end_mm: f32,
+    /// The length the quadrature's inner radii are graded by: the smallest diffusion coefficient.
+    pub near_scale_mm: f32,
+    pub pad: f32,
+}
+
+/// Where the near field begins and ends, in point spacings: the far sum's weight rises from 0
+/// at one spacing to 1 at four.
+pub const NEAR_START_SPACINGS: f32 = 1.0;
+pub const NEAR_END_SPACINGS: f32 = 4.0;
+
+impl ObjectParams {
+    /// The near field's radii for points `spacing_mm` apart, and its quadrature's scale from the
+    /// channels' diffusion coefficients.
+    pub fn near_field(spacing_mm: f32, channels: &[GpuChannel; 3]) -> (f32, f32, f32) {
+        let (start, end) = (NEAR_START_SPACINGS * spacing_mm, NEAR_END_SPACINGS * spacing_mm);
+        let d = channels.iter().filter(|c| c.transports != 0.0).map(|c| c.d).fold(f32::INFINITY, f32::min);
+        let scale = if d.is_finite() { d.clamp(1e-3 * start, start) } else { start };
+        (start, end, scale)
+    }
 }
 
 /// How a frame integrates, written from the frame's description when it begins. Mirrors
@@ -81,5 +106,7 @@ pub struct FrameParams {
     /// 1 to add the microfacet lobe.
     pub specular: u32,
     pub roughness: f32,
-    pub pad: [u32; 3],
+    /// 1 to split each pixel's sum into the near field and the far (see [`ObjectParams`]).
+    pub near_field: u32,
+    pub pad: [u32; 2],
 }
