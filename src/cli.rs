@@ -406,11 +406,11 @@ pub struct RenderArgs {
     /// Visit every sample point for every pixel (the reference for the tree).
     #[arg(long)]
     pub brute_force: bool,
-    /// The near field: sources within a few point spacings of the pixel are weighted down (to 0
-    /// within one spacing, smoothly up to 1 at four) and the pixel's own irradiance times a fixed
-    /// quadrature of ∫(1 − w) Sd dA over its tangent plane replaces them, since the few nearest
-    /// points sample the BSSRDF's peak badly. `auto`: with the tree, not with --brute-force
-    /// (the exact point sum, the reference).
+    /// The near field: the few points nearest a pixel sample the BSSRDF's peak badly, so each lit
+    /// pixel adds a control variate: its own irradiance over its tangent plane, integrated by a
+    /// fixed quadrature of ∫(1 − w) Sd dA (w rising from 0 within one point spacing to 1 at
+    /// four), less the points' estimate of the same. Costs about 1.6x the shade pass. `auto`:
+    /// with the tree, not with --brute-force (the exact point sum, the reference).
     #[arg(long, value_enum, default_value = "auto")]
     pub near_field: NearFieldArg,
     /// Leave out the surface's own (microfacet) reflection: subsurface scattering alone.
