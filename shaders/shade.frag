@@ -329,19 +329,12 @@ vec3 specular(vec3 xo, vec3 no, vec3 wo) {
 // incidence) where none reaches it. The Monte Carlo table's exit factor is read there.
 float own_cos_t(vec3 xo, vec3 no) {
     float weight = 0.0, sum = 0.0;
-    float eta = object_params.channels[0].eta;
     for (uint k = 0u; k < light_set.light_count; ++k) {
         vec3 toward;
-        uint layer;
-        vec3 incident = light_at(light_of(k), xo, toward, layer);
-        float cos_i = dot(no, toward);
-        if (cos_i <= 0.0) continue;
-        vec4 clip = layer_matrix(layer) * vec4(xo + no * light_set.normal_offset, 1.0);
-        vec3 ndc = clip.xyz / clip.w;
-        float visibility = texture(shadow_map, vec4(ndc.xy * 0.5 + 0.5, float(layer), ndc.z));
-        float e = dot(incident, vec3(0.2126, 0.7152, 0.0722)) * cos_i * fresnel_transmittance(eta, cos_i) * visibility;
+        float e = dot(light_irradiance(light_of(k), xo, no, toward), vec3(0.2126, 0.7152, 0.0722));
+        if (e <= 0.0) continue;
         weight += e;
-        sum += e * sqrt(max(1.0 - (1.0 - cos_i * cos_i) / (eta * eta), 0.0));
+        sum += e * flux_term(toward, no).w;
     }
     return weight > 0.0 ? sum / weight : 1.0;
 }
