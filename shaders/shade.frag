@@ -344,13 +344,34 @@ float own_cos_t(vec3 xo, vec3 no) {
 const uint SS_SAMPLES = 24u;
 const float SS_REACH = 10.0;
 
+// The cosine at which light toward `toward` enters the surface the shadow map sees at `uv`: its
+// normal from the depths of that texel and of the next ones across and up (unprojected by
+// `unproject`), turned toward the light; `fallback` (the pixel's own) where they do not span a
+// surface (the map's edge, a silhouette seen from the light).
+float entry_cos(vec2 uv, uint layer, mat4 unproject, vec3 toward, float fallback) {
+    vec2 size = vec2(textureSize(shadow_depth, 0).xy);
+    vec2 centre = (floor(uv * size) + 0.5) / size;
+    vec3 p[3];
+    for (int j = 0; j < 3; ++j) {
+        vec2 at = centre + (j == 1 ? vec2(1.0, 0.0) : (j == 2 ? vec2(0.0, 1.0) : vec2(0.0))) / size;
+        float d = texture(shadow_depth, vec3(at, float(layer))).r;
+        if (d >= 1.0) return fallback;
+        vec4 q = unproject * vec4(at * 2.0 - 1.0, d, 1.0);
+        p[j] = q.xyz / q.w;
+    }
+    vec3 n = cross(p[1] - p[0], p[2] - p[0]);
+    float len = length(n);
+    if (!(len > 0.0)) return fallback;
+    return clamp(abs(dot(n / len, toward)), 0.0, 1.0);
+}
+
 // Single scattering, the Monte Carlo table's (Jensen et al. 2001 §3; with its table's similarity
 // relation: σ's, σ't and an isotropic phase function). Along the refracted view ray
 // x(s) = xo + s·ωo' inside, light from each light scatters once toward the eye:
 //   Lo = Ft(θo)/η² · Σ_l E_l cos θl Ft(θl)/cos θtl · σs'/(4π) ∫ e^{−σ't (s + s_l(s))} ds,
 // s_l the light's refracted path inside: the straight distance from the surface its shadow map
-// sees toward it (the depth, unprojected), refracted as through a plane parallel to the pixel's
-// (exact on a flat half-space and a parallel slab, lit from either side). 1/η²: radiance leaving
+// sees toward it (the depth, unprojected), refracted as through the plane of that surface
+// (its normal from the map's depths, entry_cos; exact on a flat half-space and slab). 1/η²: radiance leaving
 // a denser medium. Between samples s + s_l is taken linear, so each interval's integral is exact
 // there; samples the shadow map puts outside the object (nearer the light than its surface)
 // scatter nothing, and an interval with one such end counts half.
@@ -402,7 +423,7 @@ vec3 single_scattering(vec3 xo, vec3 no, vec3 wo) {
                     cached_layer = layer;
                 }
                 vec4 p = unproject * vec4(ndc.xy, depth, 1.0);
-                float cos_l = abs(dot(no, toward));
+                float cos_l = entry_cos(uv, layer, unproject, toward, abs(dot(no, toward)));
                 // The shadow pass's slope-scaled depth bias (1.5 texels of depth slope, texels
                 // normal_offset / 2 wide) moved the surface away from the light by about
                 // 0.75 normal_offset · tan θl: put it back.
