@@ -344,6 +344,13 @@ float own_cos_t(vec3 xo, vec3 no) {
 const uint SS_SAMPLES = 24u;
 const float SS_REACH = 10.0;
 
+// (1 − e^{−a})/a per channel, by its series where f32 would cancel.
+vec3 one_minus_exp_over(vec3 a) {
+    vec3 series = vec3(1.0) - 0.5 * a + a * a / 6.0;
+    vec3 closed = (vec3(1.0) - exp(-a)) / mix(vec3(1.0), a, notEqual(a, vec3(0.0)));
+    return mix(series, closed, step(vec3(1e-3), abs(a)));
+}
+
 // The cosine at which light toward `toward` enters the surface the shadow map sees at `uv`: its
 // normal from the depths of that texel and of the next ones across and up (unprojected by
 // `unproject`), turned toward the light; `fallback` (the pixel's own) where they do not span a
@@ -353,7 +360,7 @@ float entry_cos(vec2 uv, uint layer, mat4 unproject, vec3 toward, float fallback
     vec2 centre = (floor(uv * size) + 0.5) / size;
     vec3 p[3];
     for (int j = 0; j < 3; ++j) {
-        vec2 at = centre + (j == 1 ? vec2(1.0, 0.0) : (j == 2 ? vec2(0.0, 1.0) : vec2(0.0))) / size;
+        vec2 at = centre + (j == 1 ? vec2(3.0, 0.0) : (j == 2 ? vec2(0.0, 3.0) : vec2(0.0))) / size;
         float d = texture(shadow_depth, vec3(at, float(layer))).r;
         if (d >= 1.0) return fallback;
         vec4 q = unproject * vec4(at * 2.0 - 1.0, d, 1.0);
@@ -374,7 +381,8 @@ float entry_cos(vec2 uv, uint layer, mat4 unproject, vec3 toward, float fallback
 // (its normal from the map's depths, entry_cos; exact on a flat half-space and slab). 1/η²: radiance leaving
 // a denser medium. Between samples s + s_l is taken linear, so each interval's integral is exact
 // there; samples the shadow map puts outside the object (nearer the light than its surface)
-// scatter nothing, and an interval with one such end counts half.
+// scatter nothing, and an interval with one such end counts up to where the depth differences
+// at its ends say the ray crosses the surface.
 vec3 single_scattering(vec3 xo, vec3 no, vec3 wo) {
     float mm = object_params.mm_per_unit;
     float eta = object_params.channels[0].eta;
@@ -390,17 +398,26 @@ vec3 single_scattering(vec3 xo, vec3 no, vec3 wo) {
     vec3 inward = refract_in(wo, no, eta);
     float reach = SS_REACH / slowest;
     float near_band = 2.0 * light_set.normal_offset * mm;
+    // A per-pixel fraction in [0, 1) (an integer hash of the pixel, the same every frame).
+    uvec2 q = uvec2(gl_FragCoord.xy);
+    uint h = q.x * 1973u + q.y * 9277u + 26699u;
+    h = (h ^ (h >> 16)) * 0x7feb352du;
+    h = (h ^ (h >> 15)) * 0x846ca68bu;
+    float jitter = float((h ^ (h >> 16)) >> 8) / 16777216.0;
     vec3 sum = vec3(0.0);
     for (uint l = 0u; l < light_set.light_count; ++l) {
         GpuLight light = light_of(l);
         uint cached_layer = 0xffffffffu;
         mat4 unproject = mat4(1.0);
         vec3 along = vec3(0.0); // the interval integrals of e^{−σ't g}
-        float g_prev = 0.0, s_prev = 0.0;
+        float g_prev = 0.0, s_prev = 0.0, d_prev = 0.0, slope_prev = 1.0;
         bool inside_prev = false;
         vec3 beam = vec3(0.0);
         for (uint k = 0u; k <= SS_SAMPLES; ++k) {
-            float t = float(k) / float(SS_SAMPLES);
+            // Past the pixel itself, the samples shift by a fraction of a step per pixel: where a
+            // shadow inside the object (a part of it between the ray and the light) starts
+            // between samples, fixed samples draw its edge as contour lines across the image.
+            float t = k == 0u ? 0.0 : (float(k) - 1.0 + jitter) / float(SS_SAMPLES - 1u);
             float s = reach * t * t; // mm
             vec3 x = xo + inward * (s / mm);
             vec3 toward;
@@ -414,8 +431,11 @@ vec3 single_scattering(vec3 xo, vec3 no, vec3 wo) {
             // Within a few shadow texels of the pixel (the band its depth's rounding and bias
             // blur) the ray is inside whatever the depth says.
             bool near = s < near_band;
-            bool inside = all(greaterThanEqual(uv, vec2(0.0))) && all(lessThanEqual(uv, vec2(1.0))) && depth < 1.0
-                          && (near || ndc.z > depth);
+            bool in_map = all(greaterThanEqual(uv, vec2(0.0))) && all(lessThanEqual(uv, vec2(1.0))) && depth < 1.0;
+            // How far behind the surface (in depth), < 0 in front of it; where the map sees no
+            // surface, unknown (-1e30).
+            float d = in_map ? ndc.z - depth : -1e30;
+            bool inside = in_map && (near || d > 0.0);
             float g = s;
             if (inside) {
                 if (layer != cached_layer) {
@@ -434,17 +454,26 @@ vec3 single_scattering(vec3 xo, vec3 no, vec3 wo) {
                 // The beam's flux inside per unit area across it (its irradiance at normal incidence outside).
                 beam = incident * cos_l * fresnel_transmittance(eta, cos_l) / max(cos_t, 1e-6);
             }
-            if (k > 0u && (inside || inside_prev)) {
-                float ds = s - s_prev;
+            float ds = s - s_prev;
+            if (k > 0u && inside && inside_prev) {
+                // ∫ e^{−σ(g_prev + slope (s' − s_prev))} ds' = e^{−σ g_prev} ds (1 − e^{−a})/a.
                 float slope = (g - g_prev) / ds; // d(s + s_l)/ds over the interval
-                vec3 a = sigma_t * slope * ds;
-                // ∫ e^{−σ(g_prev + slope (s' − s_prev))} ds' = e^{−σ g_prev}(1 − e^{−σ slope ds})/(σ slope).
-                // (1 − e^{−a})/a, by its series where f32 would cancel.
-                vec3 series = vec3(1.0) - 0.5 * a + a * a / 6.0;
-                vec3 closed = (vec3(1.0) - exp(-a)) / mix(vec3(1.0), a, notEqual(a, vec3(0.0)));
-                vec3 part = exp(-sigma_t * g_prev) * ds * mix(series, closed, step(vec3(1e-3), abs(a)));
-                along += (inside && inside_prev ? 1.0 : 0.5) * part * beam;
+                along += exp(-sigma_t * g_prev) * ds * one_minus_exp_over(sigma_t * slope * ds) * beam;
+                slope_prev = slope;
+            } else if (k > 0u && (inside || inside_prev)) {
+                // The ray leaves (or enters) the object within the interval: where, from the depth
+                // differences at its ends, linear between them (the middle if one is unknown), so
+                // that the sum does not jump as the object's thickness passes a sample.
+                bool known = d_prev > -1e29 && d > -1e29 && d_prev != d;
+                float f = known ? clamp(d_prev / (d_prev - d), 0.0, 1.0) : 0.5;
+                if (inside_prev) {
+                    float len = f * ds;
+                    along += exp(-sigma_t * g_prev) * len * one_minus_exp_over(sigma_t * slope_prev * len) * beam;
+                } else {
+                    along += exp(-sigma_t * g) * (1.0 - f) * ds * beam;
+                }
             }
+            d_prev = near ? max(d, 1e-7) : d;
             g_prev = g;
             s_prev = s;
             inside_prev = inside;
