@@ -324,18 +324,13 @@ vec3 specular(vec3 xo, vec3 no, vec3 wo) {
     return sum;
 }
 
-// The pixel's own angle of incidence: the refracted cosine of its lights, weighted by the
-// luminance of the irradiance each brings in (shadowed, as irradiance.comp computes it); 1 (normal
-// incidence) where none reaches it. The Monte Carlo table's exit factor is read there.
-float own_cos_t(vec3 xo, vec3 no) {
-    float weight = 0.0, sum = 0.0;
-    for (uint k = 0u; k < light_set.light_count; ++k) {
-        vec3 toward;
-        float e = dot(light_irradiance(light_of(k), xo, no, toward), vec3(0.2126, 0.7152, 0.0722));
-        if (e <= 0.0) continue;
-        weight += e;
-        sum += e * flux_term(toward, no).w;
-    }
+// The pixel's own angle of incidence, from its own flux (own_light): the refracted cosine of its
+// lights weighted by the luminance of what each brings in; 1 (normal incidence) where none
+// reaches it. The Monte Carlo table's exit factor is read there.
+float own_cos_t() {
+    vec3 luminance = vec3(0.2126, 0.7152, 0.0722);
+    float weight = dot(luminance, own_irradiance);
+    float sum = dot(luminance, vec3(own_incident[0].w, own_incident[1].w, own_incident[2].w));
     return weight > 0.0 ? sum / weight : 1.0;
 }
 
@@ -344,11 +339,17 @@ float own_cos_t(vec3 xo, vec3 no) {
 const uint SS_SAMPLES = 24u;
 const float SS_REACH = 10.0;
 
-// (1 − e^{−a})/a per channel, by its series where f32 would cancel.
-vec3 one_minus_exp_over(vec3 a) {
-    vec3 series = vec3(1.0) - 0.5 * a + a * a / 6.0;
-    vec3 closed = (vec3(1.0) - exp(-a)) / mix(vec3(1.0), a, notEqual(a, vec3(0.0)));
-    return mix(series, closed, step(vec3(1e-3), abs(a)));
+// ∫ e^{−σ g} over an interval of length `len` along which the path g ≥ 0 runs linearly from g0 to
+// g1, per channel: len (e^{−σ g0} − e^{−σ g1}) / (σ (g1 − g0)), by its series where f32 would
+// cancel. Both exponentials are at most 1, so no slope overflows it.
+vec3 interval_integral(vec3 sigma, float g0, float g1, float len) {
+    g0 = max(g0, 0.0);
+    g1 = max(g1, 0.0);
+    vec3 a = sigma * (g1 - g0);
+    vec3 e0 = exp(-sigma * g0);
+    vec3 series = e0 * (vec3(1.0) - 0.5 * a + a * a / 6.0);
+    vec3 closed = (e0 - exp(-sigma * g1)) / mix(vec3(1.0), a, notEqual(a, vec3(0.0)));
+    return len * mix(series, closed, step(vec3(1e-3), abs(a)));
 }
 
 // The cosine at which light toward `toward` enters the surface the shadow map sees at `uv`: its
@@ -450,16 +451,16 @@ vec3 single_scattering(vec3 xo, vec3 no, vec3 wo) {
                 float tan_l = sqrt(max(1.0 - cos_l * cos_l, 0.0)) / max(cos_l, 1e-3);
                 float straight = max(dot(p.xyz / p.w - x, toward) * mm + 0.75 * light_set.normal_offset * mm * tan_l, 0.0);
                 float cos_t = sqrt(max(1.0 - (1.0 - cos_l * cos_l) / (eta * eta), 0.0));
-                g = s + straight * cos_l / max(cos_t, 1e-6);
+                // Beyond the critical angle (η < 1) no light enters there.
+                bool enters = cos_t > 1e-4;
+                g = s + straight * (enters ? cos_l / cos_t : 1.0);
                 // The beam's flux inside per unit area across it (its irradiance at normal incidence outside).
-                beam = incident * cos_l * fresnel_transmittance(eta, cos_l) / max(cos_t, 1e-6);
+                beam = enters ? incident * cos_l * fresnel_transmittance(eta, cos_l) / cos_t : vec3(0.0);
             }
             float ds = s - s_prev;
             if (k > 0u && inside && inside_prev) {
-                // ∫ e^{−σ(g_prev + slope (s' − s_prev))} ds' = e^{−σ g_prev} ds (1 − e^{−a})/a.
-                float slope = (g - g_prev) / ds; // d(s + s_l)/ds over the interval
-                along += exp(-sigma_t * g_prev) * ds * one_minus_exp_over(sigma_t * slope * ds) * beam;
-                slope_prev = slope;
+                along += interval_integral(sigma_t, g_prev, g, ds) * beam;
+                slope_prev = (g - g_prev) / ds; // d(s + s_l)/ds over the interval
             } else if (k > 0u && (inside || inside_prev)) {
                 // The ray leaves (or enters) the object within the interval: where, from the depth
                 // differences at its ends, linear between them (the middle if one is unknown), so
@@ -468,7 +469,7 @@ vec3 single_scattering(vec3 xo, vec3 no, vec3 wo) {
                 float f = known ? clamp(d_prev / (d_prev - d), 0.0, 1.0) : 0.5;
                 if (inside_prev) {
                     float len = f * ds;
-                    along += exp(-sigma_t * g_prev) * len * one_minus_exp_over(sigma_t * slope_prev * len) * beam;
+                    along += interval_integral(sigma_t, g_prev, g_prev + slope_prev * len, len) * beam;
                 } else {
                     along += exp(-sigma_t * g) * (1.0 - f) * ds * beam;
                 }
@@ -674,7 +675,9 @@ void main() {
     vec3 lo = fresnel_transmittance(object_params.channels[0].eta, cos_o) * sum;
     // The Monte Carlo table's exit distribution (the others' lobe is Ft alone).
     if (MODEL == MODEL_MC) {
-        lo *= table_exit_factor(dipole_table, own_cos_t(xo, no), cos_o);
+        // The pixel's own flux: already there where the near field needed it.
+        if (frame_params.near_field == 0u) own_light(xo, no);
+        lo *= table_exit_factor(dipole_table, own_cos_t(), cos_o);
         // Single scattering, once (by the first of several brute-force draws, as the lobe).
         if (pc.point_range.x == 0u) lo += single_scattering(xo, no, wo);
     }

@@ -143,9 +143,9 @@ fn split_brute_force_matches_exact_brute_force() {
 
 /// The Monte Carlo table (`--model mc`): its single scattering is computed per pixel (no
 /// sampling), its sampled part is multiple scattering alone, whose peak at r → 0 is a logarithm:
-/// the default image meets the 1% on the sphere. Measured (48²): sphere 0.38 / 0.46 /
-/// 0.48% (without the near field 0.51 / 1.08 / 2.22%), slab 0.61 / 1.12 / 1.93% (0.89 / 1.82 /
-/// 3.52%; the box's edges, as for the other models).
+/// the default image meets the 1% on the sphere. Measured (48²): sphere 0.36 / 0.46 /
+/// 0.50% (without the near field 0.51 / 1.09 / 2.12%), slab 0.60 / 1.09 / 1.93% (0.87 / 1.81 /
+/// 3.39%; the box's edges, as for the other models).
 #[test]
 fn the_monte_carlo_table_converges() {
     for (mesh, bound, gain) in [("sphere", [0.01, 0.01, 0.01], 0.3), ("slab", [0.008, 0.014, 0.024], 0.7)] {

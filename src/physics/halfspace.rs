@@ -219,24 +219,27 @@ pub struct Escape {
     pub scatterings: u32,
 }
 
-/// Collisions after which a photon counts as absorbed: far past any path that matters for
-/// α' < 1 (its weight α'^n), and an end for α' = 1, whose returns take arbitrarily long.
+/// Collisions after which a photon of [`rte_reflectance`] counts as absorbed: far past any path
+/// that matters for α' < 1 (its weight α'^n), and an end for α' = 1, whose returns take
+/// arbitrarily long.
 pub const MAX_COLLISIONS: u32 = 1_000_000;
 
 /// The analogue Monte Carlo walk of a half-space (z < 0) of reduced albedo `albedo`, relative
 /// index `eta`, isotropic scattering, smooth boundary, in mean free paths: `photons` photons start
 /// at the origin going `start` (downward), fly exponential free paths, are absorbed with
-/// probability 1 − α' at each collision, and at the boundary are Fresnel-reflected or escape (with
-/// refraction), which `on_escape` is told.
+/// probability 1 − α' at each collision (and after `max_collisions`), and at the boundary are
+/// Fresnel-reflected or escape (with refraction), which `on_escape` is told. Returns the
+/// scatterings traced.
 pub fn trace_half_space(
     albedo: f64,
     eta: f64,
     start: DVec3,
     photons: u64,
-    seed: u64,
+    (seed, max_collisions): (u64, u32),
     mut on_escape: impl FnMut(&Escape),
-) {
+) -> u64 {
     let mut rng = SplitMix(seed);
+    let mut collisions = 0u64;
     for _ in 0..photons {
         let (mut x, mut y, mut z) = (0.0f64, 0.0f64, 0.0f64);
         let mut d = start;
@@ -261,16 +264,18 @@ pub fn trace_half_space(
             x += s * d.x;
             y += s * d.y;
             z = z_next;
-            if rng.next() >= albedo || scatterings >= MAX_COLLISIONS {
+            if rng.next() >= albedo || scatterings >= max_collisions {
                 break;
             }
             scatterings += 1;
+            collisions += 1;
             let mu = 2.0 * rng.next() - 1.0;
             let phi = 2.0 * PI * rng.next();
             let s = (1.0 - mu * mu).max(0.0).sqrt();
             d = DVec3::new(s * phi.cos(), s * phi.sin(), mu);
         }
     }
+    collisions
 }
 
 /// The refracted direction of light entering at cos θi = `cos_i` (z down into the medium is
@@ -289,7 +294,7 @@ pub fn rte_reflectance(albedo: f64, eta: f64, cos_i: f64, photons: u64, seed: u6
     let mut escaped = vec![0u64; RADIANCE_BINS];
     let mut count = 0u64;
     let mut once = 0u64;
-    trace_half_space(albedo, eta, entry_direction(eta, cos_i), photons, seed, |e| {
+    let _ = trace_half_space(albedo, eta, entry_direction(eta, cos_i), photons, (seed, MAX_COLLISIONS), |e| {
         let k = ((e.mu_o2 * RADIANCE_BINS as f64) as usize).min(RADIANCE_BINS - 1);
         escaped[k] += 1;
         count += 1;

@@ -50,21 +50,31 @@ pub const ESCAPES_NORMAL: u64 = 200_000;
 pub const ESCAPES_OBLIQUE: u64 = 40_000;
 pub const MAX_PHOTONS_NORMAL: u64 = 20_000_000;
 pub const MAX_PHOTONS_OBLIQUE: u64 = 2_500_000;
-const BATCH: u64 = 25_000;
+/// Scatterings after which a run stops taking batches, at normal incidence and at each other node:
+/// what bounds the time where α' → 1 (at α' = 1 a photon's walk home has no finite mean; Marble's
+/// α' = 0.999 takes about 5e7 and 1e7).
+pub const MAX_SCATTERINGS_NORMAL: u64 = 60_000_000;
+pub const MAX_SCATTERINGS_OBLIQUE: u64 = 15_000_000;
+const BATCH: u64 = 5_000;
+/// A photon's scatterings before it counts as absorbed: at α' = 0.999 its weight there is e^{−100};
+/// at α' = 1 about 0.2% of the photons walk longer (the escape fraction that much low).
+const MAX_COLLISIONS: u32 = 100_000;
 
 /// Batches of [`halfspace::trace_half_space`] (seeds `seed`, `seed + 1`, …) until `escapes`
-/// photons left or `max_photons` were traced. Returns the photons traced.
+/// photons left, or `max_photons` were traced, or `max_scatterings` scatterings. Returns the
+/// photons traced.
 fn trace_until(
     albedo: f64,
     eta: f64,
     start: glam::DVec3,
-    (escapes, max_photons): (u64, u64),
+    (escapes, max_photons, max_scatterings): (u64, u64, u64),
     seed: u64,
     mut on_escape: impl FnMut(&halfspace::Escape),
 ) -> u64 {
-    let (mut traced, mut escaped) = (0u64, 0u64);
-    while escaped < escapes && traced < max_photons {
-        halfspace::trace_half_space(albedo, eta, start, BATCH, seed.wrapping_add(traced / BATCH), |e| {
+    let (mut traced, mut escaped, mut scatterings) = (0u64, 0u64, 0u64);
+    while escaped < escapes && traced < max_photons && scatterings < max_scatterings {
+        let seed = (seed.wrapping_add(traced / BATCH), MAX_COLLISIONS);
+        scatterings += halfspace::trace_half_space(albedo, eta, start, BATCH, seed, |e| {
             escaped += 1;
             on_escape(e)
         });
@@ -170,22 +180,36 @@ impl McProfile {
             let start = glam::DVec3::new(sin_t, 0.0, -cos_t);
             let seed = 0x5eed_0000_0000 + ((k as u64) << 32);
             *traced = if k == INCIDENCE_NODES - 1 {
-                trace_until(albedo, eta, start, (ESCAPES_NORMAL, MAX_PHOTONS_NORMAL), seed, |e| {
-                    if e.scatterings == 1 {
-                        single += 1;
-                        return;
-                    }
-                    if let Some(k) = bin_of((e.x * e.x + e.y * e.y).sqrt()) {
-                        density[k] += 1.0;
-                    }
-                    exit_counts[exit_bin(e)] += 1;
-                })
-            } else {
-                trace_until(albedo, eta, start, (ESCAPES_OBLIQUE, MAX_PHOTONS_OBLIQUE), seed, |e| {
-                    if e.scatterings >= 2 {
+                trace_until(
+                    albedo,
+                    eta,
+                    start,
+                    (ESCAPES_NORMAL, MAX_PHOTONS_NORMAL, MAX_SCATTERINGS_NORMAL),
+                    seed,
+                    |e| {
+                        if e.scatterings == 1 {
+                            single += 1;
+                            return;
+                        }
+                        if let Some(k) = bin_of((e.x * e.x + e.y * e.y).sqrt()) {
+                            density[k] += 1.0;
+                        }
                         exit_counts[exit_bin(e)] += 1;
-                    }
-                })
+                    },
+                )
+            } else {
+                trace_until(
+                    albedo,
+                    eta,
+                    start,
+                    (ESCAPES_OBLIQUE, MAX_PHOTONS_OBLIQUE, MAX_SCATTERINGS_OBLIQUE),
+                    seed,
+                    |e| {
+                        if e.scatterings >= 2 {
+                            exit_counts[exit_bin(e)] += 1;
+                        }
+                    },
+                )
             };
         }
         let escape_of = |(traced, counts): &(u64, [u64; EXIT_BINS])| counts.iter().sum::<u64>() as f64 / *traced as f64;
