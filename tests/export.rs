@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use common::{output_dir, repo_path, translucent};
 use glam::{DVec3, Vec3};
 use translucent::export::mitsuba::{
-    auto_rr_depth, disk_radiance, homogeneous, read_ply, write_scene, Camera, Light, Medium, Object, Options, Surface,
+    disk_radiance, homogeneous, read_ply, write_scene, Camera, Light, Medium, Object, Options, Surface, NO_ROULETTE,
 };
 use translucent::materials::Material;
 use translucent::mesh::Mesh;
@@ -117,6 +117,9 @@ fn a_translucent_sphere_with_a_directional_light() {
     assert_eq!(info["subsurface_only"], true);
     assert_eq!(info["width"], 80);
     assert!(xml.contains("name=\"specular_transmittance\" value=\"$transmittance\""));
+    // Unbounded depth and no Russian roulette (it darkened high-albedo media; see NO_ROULETTE).
+    assert!(xml.contains("<default name=\"max_depth\" value=\"-1\"/>"), "{xml}");
+    assert!(xml.contains(&format!("<default name=\"rr_depth\" value=\"{NO_ROULETTE}\"/>")), "{xml}");
     // The mesh: the renderer's sphere in mm, normals and triangles unchanged.
     let ply = read_ply(&dir.join("object0.ply")).expect("PLY");
     let sphere = Mesh::sphere(1.0, 48);
@@ -311,16 +314,6 @@ fn a_disk_of_that_radiance_gives_the_irradiance() {
             .sum();
         assert!((e - 1.0).abs() < 1e-6, "{deg}°: {e}");
     }
-}
-
-#[test]
-fn roulette_starts_where_the_throughput_falls_below_its_cap() {
-    let h = |a: f64| homogeneous(&Medium { sigma_a: [1.0 - a; 3], sigma_s: [a; 3], g: [0.0; 3], eta: 1.3 });
-    // α = 0.999: 0.999^n < 0.95 from n = 52 on.
-    assert_eq!(auto_rr_depth(&[h(0.999)]), 52 + 5);
-    assert_eq!(auto_rr_depth(&[h(0.5)]), 6);
-    assert_eq!(auto_rr_depth(&[h(1.0)]), 1000);
-    assert_eq!(auto_rr_depth(&[]), 5);
 }
 
 fn expect_bad(args: &[&str], says: &str) {
