@@ -424,17 +424,24 @@ fn keys_pressed_while_a_preview_shades_end_in_the_image_of_the_same_settings() {
         let out = cmd.output().expect("run xdotool");
         String::from_utf8_lossy(&out.stdout).trim().to_string()
     };
-    let window = (0..600)
-        .find_map(|_| {
-            let id = xdo(&["search", "--name", "translucent"]);
-            if id.is_empty() {
-                std::thread::sleep(std::time::Duration::from_millis(100));
-                None
-            } else {
-                Some(id.lines().next().unwrap_or_default().to_string())
-            }
-        })
-        .expect("the viewer's window appears");
+    let mut viewer = viewer;
+    let window = (0..600).find_map(|_| {
+        let id = xdo(&["search", "--name", "translucent"]);
+        if id.is_empty() {
+            std::thread::sleep(std::time::Duration::from_millis(100));
+            None
+        } else {
+            Some(id.lines().next().unwrap_or_default().to_string())
+        }
+    });
+    let Some(window) = window else {
+        // Say why: the viewer's status and what it printed (it may have exited at start).
+        let _ = viewer.kill();
+        let out = viewer.wait_with_output().expect("the viewer exits");
+        let _ = xvfb.kill();
+        let _ = xvfb.wait();
+        panic!("the viewer's window did not appear within a minute; exit {:?}:\n{}", out.status.code(), stderr(&out));
+    };
     xdo(&["windowfocus", "--sync", &window]);
     // The first frame (full, 256x192) first; then the keys.
     std::thread::sleep(std::time::Duration::from_secs(4));
