@@ -56,6 +56,7 @@ layout(binding = 15) uniform usamplerBuffer point_spread;
 // The same shadow map's depth, unfiltered: how far light travels inside (single scattering).
 layout(binding = 16) uniform sampler2DArray shadow_depth;
 vec4 dipole_header; // its texel 0, read once per pixel
+float slab_unit; // the Monte Carlo table's L (mm), read once per pixel (0 for the other models)
 
 const uint STACK_SIZE = 96u;
 // Points nearer than this many diffusion lengths (1/σtr) of the farthest-reaching channel are
@@ -87,6 +88,30 @@ float near_weight(vec3 xi, vec3 xo) {
     return 1.0 - smoothstep(object_params.near_start_mm, object_params.near_end_mm, length(xo - xi) * object_params.mm_per_unit);
 }
 
+// The Monte Carlo table's light across the object (physics::slab_profile): a source whose
+// normal faces away from the pixel's (w = −ni·no > 0) and lies behind the pixel's tangent plane
+// is read as across a flat slab of thickness t = (xo − xi)·no, at lateral distance ρ, in
+// S = (1 − w) Sp(r) + w T(ρ; t): this returns (1 − w) times the half-space's `sd` and adds
+// w T · `power_mm` to across_sum, and its luminance-weighted thickness to across_thickness (the
+// exit factor h_T is read once per pixel at their mean, main()).
+vec3 across_sum = vec3(0.0);
+vec2 across_thickness = vec2(0.0); // Σ t·luminance, Σ luminance
+vec3 across(vec3 xi, vec3 ni, vec3 xo, vec3 no, vec3 sd, vec3 power_mm) {
+    float w = -dot(ni, no);
+    if (w <= 0.0) return sd;
+    float s = object_params.mm_per_unit;
+    vec3 d = (xo - xi) * s;
+    float t = dot(d, no);
+    if (t <= 0.0) return sd;
+    float rho = length(d - t * no);
+    w = min(w, 1.0);
+    vec3 through = w * slab_transmission(dipole_table, slab_unit, rho, t) * power_mm;
+    across_sum += through;
+    float luminance = dot(through, vec3(0.2126, 0.7152, 0.0722));
+    across_thickness += vec2(t * luminance, luminance);
+    return (1.0 - w) * sd;
+}
+
 vec3 source(vec3 xi, vec3 ni, vec3 wi, vec3 power, vec3 xo, vec3 no) {
     float s = object_params.mm_per_unit;
     vec3 sd;
@@ -100,6 +125,7 @@ vec3 source(vec3 xi, vec3 ni, vec3 wi, vec3 power, vec3 xo, vec3 no) {
                   dirpole_channel_sd(object_params.channels[2], g, xi_mm, xo_mm, no));
     } else {
         sd = dipole_sd_table(dipole_table, dipole_header, length(xo - xi) * s);
+        if (MODEL == MODEL_MC) sd = across(xi, ni, xo, no, sd, power * (s * s));
     }
     return sd * power * (s * s); // power is irradiance × scene-unit area: to mm²
 }
@@ -127,6 +153,7 @@ vec3 merged_source(vec3 xi, vec3 ni, vec3 power, vec4 incident[3], vec3 dw, vec3
         sd.z = dirpole_channel_sd(object_params.channels[2], with_refracted(g, w[2], no), xi_mm, xo_mm, no);
     } else {
         sd = dipole_sd_table(dipole_table, dipole_header, length(xo - xi) * s);
+        if (MODEL == MODEL_MC) sd = across(xi, ni, xo, no, sd, power * (s * s));
     }
     return sd * power * (s * s); // power is irradiance × scene-unit area: to mm²
 }
@@ -515,6 +542,7 @@ void main() {
     vec3 xo = surface.xyz;
     vec3 no = normalize(imageLoad(surface_normal, pixel).xyz);
     dipole_header = dipole_table_header(dipole_table);
+    slab_unit = MODEL == MODEL_MC ? slab_unit_mm(dipole_table) : 0.0;
     vec3 wo = normalize(pc.eye.xyz - xo);
     vec3 sum = vec3(0.0);
     uint visits = 0u;
@@ -694,6 +722,13 @@ void main() {
         // The pixel's own flux: already there where the near field needed it.
         if (frame_params.near_field == 0u) own_light(xo, no);
         lo *= table_exit_factor(dipole_table, own_cos_t(), cos_o);
+        if (across_thickness.y > 0.0) {
+            float t = across_thickness.x / across_thickness.y;
+            lo += fresnel_transmittance(object_params.channels[0].eta, cos_o) * across_sum
+                * slab_exit_factor(dipole_table, slab_unit, t, cos_o);
+        } else {
+            lo += fresnel_transmittance(object_params.channels[0].eta, cos_o) * across_sum;
+        }
         // Single scattering, once (by the first of several brute-force draws, as the lobe).
         if (pc.point_range.x == 0u) lo += single_scattering(xo, no, wo);
     }

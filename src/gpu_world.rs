@@ -9,13 +9,14 @@ use crate::bad_input;
 use crate::budget::{self, FrameSizes};
 use crate::error::Result;
 use crate::frame_desc::FrameDesc;
-use crate::gpu::sd_table::AngularFactors;
+use crate::gpu::sd_table::{AngularFactors, SlabTransmission};
 use crate::gpu::{DiffuseSurfaceConstants, GpuChannel, ObjectParams, SdTable};
 use crate::hierarchy::{self, Hierarchy, HierarchyOptions};
 use crate::materials::Material;
 use crate::mesh::Mesh;
 use crate::physics::beam_diffusion::BeamMedium;
 use crate::physics::mc_profile::McProfile;
+use crate::physics::slab_profile;
 use crate::physics::{Diffusion, Model};
 use crate::scene::Light;
 use crate::shadows::Shadows;
@@ -355,8 +356,8 @@ impl GpuObject {
         let mut sd_table = Buffer::new(
             ctx,
             "Sd table",
-            // A header texel, TABLE_SIZE - 1 pairs and the angular factors.
-            ((crate::gpu::sd_table::TABLE_SIZE + AngularFactors::TEXELS) * 16) as u64,
+            // A header texel, TABLE_SIZE - 1 pairs, the angular factors and the slab's transmission.
+            ((crate::gpu::sd_table::TABLE_SIZE + AngularFactors::TEXELS + SlabTransmission::TEXELS) * 16) as u64,
             BufferUsageFlags::UNIFORM_TEXEL_BUFFER,
             MemoryLocation::CpuToGpu,
         )?;
@@ -404,17 +405,31 @@ fn write_params(params: &mut Buffer, table: &mut Buffer, from: &MadeFrom, point_
             pad: 0.0,
         }],
     )?;
-    let (sd_table, factors) = match from.table {
-        TableProfile::Dipole => (SdTable::dipole(&[0, 1, 2].map(constants)), AngularFactors::none()),
+    let (sd_table, factors, across) = match from.table {
+        TableProfile::Dipole => {
+            (SdTable::dipole(&[0, 1, 2].map(constants)), AngularFactors::none(), SlabTransmission::none())
+        }
         TableProfile::BeamDiffusion => (
             SdTable::beam_diffusion(&[0, 1, 2].map(|c| BeamMedium::new(&from.material.channel(c)))),
             AngularFactors::none(),
+            SlabTransmission::none(),
         ),
         TableProfile::MonteCarlo => {
-            let profiles = McProfile::of_channels(&[0, 1, 2].map(|c| from.material.channel(c)));
-            (SdTable::monte_carlo(&profiles, &[0, 1, 2].map(constants)), AngularFactors::monte_carlo(&profiles))
+            let media = [0, 1, 2].map(|c| from.material.channel(c));
+            let (profiles, slabs) = std::thread::scope(|s| {
+                let slabs = s.spawn(|| slab_profile::of_channels(&media));
+                let profiles = McProfile::of_channels(&media);
+                (profiles, slabs.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+            });
+            (
+                SdTable::monte_carlo(&profiles, &[0, 1, 2].map(constants)),
+                AngularFactors::monte_carlo(&profiles),
+                SlabTransmission::monte_carlo(&slabs),
+            )
         }
     };
     table.write(0, &sd_table.texels())?;
-    table.write((crate::gpu::sd_table::TABLE_SIZE * 16) as u64, &factors.texels())
+    let factors_at = crate::gpu::sd_table::TABLE_SIZE * 16;
+    table.write(factors_at as u64, &factors.texels())?;
+    table.write((factors_at + AngularFactors::TEXELS * 16) as u64, &across.texels())
 }

@@ -55,7 +55,7 @@ pub const MODELS: &[ModelEntry] = &[
         aliases: &["monte-carlo"],
         label: "Monte Carlo table",
         gpu_code: MODEL_MC,
-        about: "the flat half-space's exact transport, tabulated by Monte Carlo: radial profile, incidence and exit factors",
+        about: "the flat half-space's exact transport, tabulated by Monte Carlo (radial profile, incidence and exit factors), and a flat slab's for light across the object",
     },
 ];
 

@@ -4,6 +4,7 @@
 
 use crate::physics::beam_diffusion::{self, BeamMedium};
 use crate::physics::mc_profile::{self, McProfile};
+use crate::physics::slab_profile::{self, SlabChannel};
 use crate::physics::{dipole, ChannelConstants};
 
 /// Entries of [`SdTable`] (shared with bssrdf.glsl).
@@ -176,6 +177,57 @@ impl AngularFactors {
 
     /// Texels after the Sd table.
     pub const TEXELS: usize = mc_profile::INCIDENCE_NODES * (1 + mc_profile::EXIT_BINS);
+}
+
+const _: () = assert!(slab_profile::THICKNESS_NODES == super::SLAB_THICKNESS_NODES as usize);
+const _: () = assert!(slab_profile::ENTRIES == super::SLAB_ENTRIES as usize);
+const _: () = assert!(slab_profile::FIRST_NODE_LOG2 + 8 == super::SLAB_FIRST_NODE_LOG2_PLUS_8 as i32);
+
+/// The Monte Carlo table's light across an object, after the angular factors in the same buffer
+/// (bssrdf.glsl's `slab_transmission`, `slab_exit_factor`; [`SlabChannel`]): a header texel (L in
+/// mm; 0 for the other models, which never read the rest), then per thickness node its ENTRIES
+/// values T·reach² per channel, then per node its EXIT_BINS exit factors h_T (f32 bits).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SlabTransmission {
+    pub unit_mm: f32,
+    /// Per node, per entry.
+    pub scaled: Vec<[[f32; 3]; slab_profile::ENTRIES]>,
+    /// Per node, per exit bin.
+    pub exit: Vec<[[f32; 3]; slab_profile::EXIT_BINS]>,
+}
+
+impl SlabTransmission {
+    /// Nothing across (the models without it).
+    pub fn none() -> SlabTransmission {
+        SlabTransmission {
+            unit_mm: 0.0,
+            scaled: vec![[[0.0; 3]; slab_profile::ENTRIES]; slab_profile::THICKNESS_NODES],
+            exit: vec![[[1.0; 3]; slab_profile::EXIT_BINS]; slab_profile::THICKNESS_NODES],
+        }
+    }
+
+    pub fn monte_carlo(channels: &[std::sync::Arc<SlabChannel>; 3]) -> SlabTransmission {
+        let centre = |i: usize| (i as f64 + 0.5) / slab_profile::ENTRIES as f64;
+        SlabTransmission {
+            unit_mm: channels[0].unit_mm as f32,
+            scaled: (0..slab_profile::THICKNESS_NODES)
+                .map(|k| std::array::from_fn(|i| [0, 1, 2].map(|c| channels[c].node_scaled(k, centre(i)) as f32)))
+                .collect(),
+            exit: (0..slab_profile::THICKNESS_NODES)
+                .map(|k| std::array::from_fn(|b| [0, 1, 2].map(|c| channels[c].exit[k][b] as f32)))
+                .collect(),
+        }
+    }
+
+    pub fn texels(&self) -> Vec<[u32; 4]> {
+        let header = std::iter::once([self.unit_mm, 0.0, 0.0, 0.0].map(f32::to_bits));
+        let scaled = self.scaled.iter().flatten().map(|v| [v[0], v[1], v[2], 0.0].map(f32::to_bits));
+        let exit = self.exit.iter().flatten().map(|h| [h[0], h[1], h[2], 0.0].map(f32::to_bits));
+        header.chain(scaled).chain(exit).collect()
+    }
+
+    /// Texels after the angular factors.
+    pub const TEXELS: usize = 1 + slab_profile::THICKNESS_NODES * (slab_profile::ENTRIES + slab_profile::EXIT_BINS);
 }
 
 /// Beam diffusion's entry at `r` of a table of `reach`: Sd, but at r = 0 the v0 for which the

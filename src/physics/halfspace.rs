@@ -209,14 +209,16 @@ impl SplitMix {
     }
 }
 
-/// Where a photon of [`trace_half_space`] left the medium: its position on the boundary relative
-/// to the entry point (mean free paths), cos²θo outside and how often it scattered.
+/// Where a photon of [`trace_slab`] left the medium: its position on the boundary it crossed
+/// relative to the entry point (mean free paths), cos²θo outside, how often it scattered, and
+/// whether it left through the far face (transmitted) rather than the one it entered by.
 #[derive(Clone, Copy, Debug)]
 pub struct Escape {
     pub x: f64,
     pub y: f64,
     pub mu_o2: f64,
     pub scatterings: u32,
+    pub transmitted: bool,
 }
 
 /// Collisions after which a photon of [`rte_reflectance`] counts as absorbed: far past any path
@@ -224,15 +226,28 @@ pub struct Escape {
 /// arbitrarily long.
 pub const MAX_COLLISIONS: u32 = 1_000_000;
 
-/// The analogue Monte Carlo walk of a half-space (z < 0) of reduced albedo `albedo`, relative
-/// index `eta`, isotropic scattering, smooth boundary, in mean free paths: `photons` photons start
-/// at the origin going `start` (downward), fly exponential free paths, are absorbed with
-/// probability 1 − α' at each collision (and after `max_collisions`), and at the boundary are
-/// Fresnel-reflected or escape (with refraction), which `on_escape` is told. Returns the
-/// scatterings traced.
+/// [`trace_slab`] of infinite thickness: the half-space z < 0.
 pub fn trace_half_space(
     albedo: f64,
     eta: f64,
+    start: DVec3,
+    photons: u64,
+    seeds: (u64, u32),
+    on_escape: impl FnMut(&Escape),
+) -> u64 {
+    trace_slab(albedo, eta, f64::INFINITY, start, photons, seeds, on_escape)
+}
+
+/// The analogue Monte Carlo walk of a slab −`thickness` < z < 0 (mean free paths; infinite: the
+/// half-space) of reduced albedo `albedo`, relative index `eta` on both faces, isotropic
+/// scattering, smooth boundaries: `photons` photons start at the origin going `start` (downward),
+/// fly exponential free paths, are absorbed with probability 1 − α' at each collision (and after
+/// `max_collisions`), and at either face are Fresnel-reflected or escape (with refraction), which
+/// `on_escape` is told. Returns the scatterings traced.
+pub fn trace_slab(
+    albedo: f64,
+    eta: f64,
+    thickness: f64,
     start: DVec3,
     photons: u64,
     (seed, max_collisions): (u64, u32),
@@ -247,18 +262,20 @@ pub fn trace_half_space(
         loop {
             let s = -rng.next().ln();
             let z_next = z + s * d.z;
-            if z_next >= 0.0 {
-                // Reaches the boundary from inside: the cosine there is d.z > 0.
-                let t = -z / d.z;
+            if z_next >= 0.0 || z_next <= -thickness {
+                // Reaches a face from inside: the cosine there is |d.z| > 0.
+                let far = z_next < 0.0;
+                let t = if far { (-thickness - z) / d.z } else { -z / d.z };
                 x += t * d.x;
                 y += t * d.y;
-                if rng.next() < fresnel::reflectance(1.0 / eta, d.z) {
+                let cos = d.z.abs();
+                if rng.next() < fresnel::reflectance(1.0 / eta, cos) {
                     d.z = -d.z;
-                    z = 0.0;
+                    z = if far { -thickness } else { 0.0 };
                     continue;
                 }
-                let mu_o2 = 1.0 - eta * eta * (1.0 - d.z * d.z);
-                on_escape(&Escape { x, y, mu_o2: mu_o2.clamp(0.0, 1.0), scatterings });
+                let mu_o2 = 1.0 - eta * eta * (1.0 - cos * cos);
+                on_escape(&Escape { x, y, mu_o2: mu_o2.clamp(0.0, 1.0), scatterings, transmitted: far });
                 break;
             }
             x += s * d.x;

@@ -21,8 +21,9 @@
 //! Like pbrt-v4's `TabulatedBSSRDF` it is a table of the semi-infinite medium (Christensen and
 //! Burley 2015 fit such Monte Carlo profiles; here they are used as measured); it is exact on a
 //! flat, thick medium lit at any angle (in total and exit distribution) and at normal incidence
-//! (in profile). Its multiple scattering knows neither thickness nor curvature; its single
-//! scattering sees both.
+//! (in profile). Its multiple scattering knows no curvature, and thickness only where the shade
+//! pass reads a pair of points across the object as a local slab ([`super::slab_profile`]); its
+//! single scattering sees both.
 //!
 //! Scattering is isotropic with the reduced coefficients (the similarity relation), as in the
 //! half-space yardstick. Lengths are in mm; the Monte Carlo works in mean free paths 1/σ't.

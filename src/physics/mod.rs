@@ -12,6 +12,7 @@ pub mod fresnel;
 pub mod halfspace;
 pub mod mc_profile;
 pub mod microfacet;
+pub mod slab_profile;
 
 /// Which diffusion coefficient the directional dipole uses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]

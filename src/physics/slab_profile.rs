@@ -1,0 +1,253 @@
+//! Light across an object, tabulated by Monte Carlo (`--model mc`'s transmission): the radial
+//! profile T(ρ; t) of the multiple scattering (two or more scatterings) that a flat slab of
+//! thickness t lets out of its far face, at lateral distance ρ from where a beam entered the near
+//! face at normal incidence, per unit power entering, measured per channel by the analogue
+//! Monte Carlo of [`super::halfspace::trace_slab`] at thicknesses t_k = L · 2^(k/2 − 4), k = 0 …
+//! [`THICKNESS_NODES`] − 1 (L/16 to 90 L), L the material's longest reduced mean free path (its
+//! most translucent channel), with the exit distribution h_T of what it lets through.
+//!
+//! Why: the half-space's profile Sp(r) of [`super::mc_profile`] read at the distance through an
+//! object is a different transport: in the half-space light that travels r has done so along
+//! the surface, leaving through it all the way, and no far face reflects any back. Through
+//! Skin1's 2 mm slab it made 0.92 / 0.41 / 0.19 (R G B) of the slab's transmitted multiple
+//! scattering and Potato's red 1.86× it (tests/slab_profile.rs prints them).
+//!
+//! The shade pass (shaders/shade.frag `across`, bssrdf.glsl `slab_transmission`) reads a pair of
+//! points whose normals face away from each other, the source behind the pixel's tangent plane,
+//! as a local slab: thickness t = (xo − xi)·no, lateral distance ρ, in the blend
+//! S = (1 − w) Sp(r) + w T(ρ; t), w = −ni·no (1 across a flat slab, 0 where the normals are
+//! perpendicular, so nothing jumps), with the exit factor h_T read once per pixel at the
+//! luminance-weighted mean thickness of its sources across, and the half-space's incidence factor
+//! (an approximation: oblique light crossing a slab is not measured). Between nodes the profile
+//! is interpolated at the same u = ρ/(ρ + t + L) in units of (t + L)² (its width grows as t + L),
+//! geometrically in value and linearly in t (a thick slab's transmission falls exponentially in
+//! t); below node 0 it holds; over the last half octave it fades to 0 (there a slab lets through
+//! less than 1e-3 of what enters wherever anything is absorbed). Where the object is not a slab
+//! (a sphere, whose walls keep the light a slab would spread sideways) it is an approximation:
+//! the README's table measures it.
+
+use super::{halfspace, Medium};
+use std::collections::HashMap;
+use std::f64::consts::PI;
+use std::sync::{Arc, Mutex, OnceLock};
+
+/// Thickness nodes t_k = L · 2^(k/2 + FIRST_NODE_LOG2), half an octave apart (an octave apart,
+/// the interpolation between them lost up to 14% of Skin1's blue through 2 mm).
+pub const THICKNESS_NODES: usize = 22;
+pub const FIRST_NODE_LOG2: i32 = -4;
+/// Bins of the transmitted exit distribution h_T, equal in cos²θo outside (as
+/// [`super::mc_profile::EXIT_BINS`]).
+pub const EXIT_BINS: usize = super::mc_profile::EXIT_BINS;
+/// Radial entries per node, equally spaced in u = ρ/(ρ + reach), reach = t_k + L: entry i holds
+/// the bin u ∈ [i, i + 1)/ENTRIES at its centre.
+pub const ENTRIES: usize = 64;
+/// Transmitted photons wanted per node, and the caps on photons and scatterings (what bounds a
+/// thick node of a medium that absorbs nothing).
+const TRANSMITTED: u64 = 30_000;
+const MAX_PHOTONS: u64 = 600_000;
+const MAX_SCATTERINGS: u64 = 8_000_000;
+const BATCH: u64 = 5_000;
+const MAX_COLLISIONS: u32 = 100_000;
+
+/// Thickness of node `k` in units of L.
+pub fn node_thickness(k: usize) -> f64 {
+    2f64.powf(k as f64 / 2.0 + FIRST_NODE_LOG2 as f64)
+}
+
+/// The node coordinate of thickness t (units of L): k at node k.
+pub fn node_coordinate(thickness: f64) -> f64 {
+    2.0 * (thickness.log2() - FIRST_NODE_LOG2 as f64)
+}
+
+/// One channel's transmission profiles.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SlabChannel {
+    /// L (mm): the unit of the nodes' thicknesses.
+    pub unit_mm: f64,
+    /// Per node, the fraction of the power entering that leaves the far face after two or more
+    /// scatterings.
+    pub transmitted: [f64; THICKNESS_NODES],
+    /// Per node, per entry: T as an Sd, the exitance per unit power entering over the lobe's
+    /// ∫Ft cos θ dω (1/mm²).
+    pub sd: Vec<[f64; ENTRIES]>,
+    /// Per node, per exit bin: h_T, the transmitted radiance per unit transmitted exitance over
+    /// the lobe Ft(θo)/∫Ft cos θ dω (1 where the lobe is exact).
+    pub exit: Vec<[f64; EXIT_BINS]>,
+}
+
+/// The reach of node `k`'s radial map (mm).
+fn reach_mm(unit_mm: f64, k: usize) -> f64 {
+    unit_mm * (node_thickness(k) + 1.0)
+}
+
+/// ρ (mm) at u of a map of `reach`.
+fn rho_of(u: f64, reach: f64) -> f64 {
+    if u >= 1.0 {
+        f64::INFINITY
+    } else {
+        reach * u / (1.0 - u)
+    }
+}
+
+impl SlabChannel {
+    /// Measures one channel with unit `unit_mm` (deterministic: fixed seeds); cached.
+    pub fn of(m: &Medium, unit_mm: f64) -> Arc<SlabChannel> {
+        static CACHE: OnceLock<Mutex<HashMap<[u64; 5], Arc<SlabChannel>>>> = OnceLock::new();
+        let key = [m.sigma_a, m.sigma_s, m.g, m.eta, unit_mm].map(f64::to_bits);
+        let cache = CACHE.get_or_init(Default::default);
+        if let Some(p) = cache.lock().unwrap_or_else(|e| e.into_inner()).get(&key) {
+            return p.clone();
+        }
+        let p = Arc::new(SlabChannel::measure(m, unit_mm));
+        cache.lock().unwrap_or_else(|e| e.into_inner()).insert(key, p.clone());
+        p
+    }
+
+    fn measure(m: &Medium, unit_mm: f64) -> SlabChannel {
+        let sigma_s_reduced = m.sigma_s * (1.0 - m.g);
+        let sigma_t = m.sigma_a + sigma_s_reduced;
+        let mut out = SlabChannel {
+            unit_mm,
+            transmitted: [0.0; THICKNESS_NODES],
+            sd: vec![[0.0; ENTRIES]; THICKNESS_NODES],
+            exit: vec![[1.0; EXIT_BINS]; THICKNESS_NODES],
+        };
+        if !(sigma_s_reduced > 0.0 && sigma_t > 0.0 && unit_mm > 0.0 && unit_mm.is_finite()) {
+            return out;
+        }
+        let albedo = sigma_s_reduced / sigma_t;
+        let exit_norm = super::beam_diffusion::exit_normalisation(m.eta);
+        let entry_start = glam::DVec3::new(0.0, 0.0, -1.0);
+        for k in 0..THICKNESS_NODES {
+            let thickness_mfp = node_thickness(k) * unit_mm * sigma_t;
+            let reach = reach_mm(unit_mm, k);
+            let mut counts = [0u64; ENTRIES];
+            let mut exit_counts = [0u64; EXIT_BINS];
+            let (mut traced, mut through, mut scatterings) = (0u64, 0u64, 0u64);
+            while through < TRANSMITTED && traced < MAX_PHOTONS && scatterings < MAX_SCATTERINGS {
+                let seed = (0x51ab_0000_0000 + ((k as u64) << 32) + traced / BATCH, MAX_COLLISIONS);
+                scatterings += halfspace::trace_slab(albedo, m.eta, thickness_mfp, entry_start, BATCH, seed, |e| {
+                    if !e.transmitted || e.scatterings < 2 {
+                        return;
+                    }
+                    through += 1;
+                    let rho = (e.x * e.x + e.y * e.y).sqrt() / sigma_t;
+                    let u = rho / (rho + reach);
+                    counts[((u * ENTRIES as f64) as usize).min(ENTRIES - 1)] += 1;
+                    exit_counts[((e.mu_o2 * EXIT_BINS as f64) as usize).min(EXIT_BINS - 1)] += 1;
+                });
+                traced += BATCH;
+            }
+            let fraction = through as f64 / traced as f64;
+            out.transmitted[k] = fraction;
+            for (i, sd) in out.sd[k].iter_mut().enumerate() {
+                let (r0, r1) =
+                    (rho_of(i as f64 / ENTRIES as f64, reach), rho_of((i + 1) as f64 / ENTRIES as f64, reach));
+                let area = PI * (r1 * r1 - r0 * r0);
+                *sd = if area.is_finite() { counts[i] as f64 / traced as f64 / area / exit_norm } else { 0.0 };
+            }
+            for (b, h) in out.exit[k].iter_mut().enumerate() {
+                // Bin b's projected solid angle is π/EXIT_BINS; Ft over it at its midpoint in cos²θo.
+                let radiance = exit_counts[b] as f64 / traced as f64 / (PI / EXIT_BINS as f64);
+                let ft = super::fresnel::transmittance(m.eta, ((b as f64 + 0.5) / EXIT_BINS as f64).sqrt());
+                if exit_counts[b] > 0 && fraction > 0.0 && ft > 0.0 {
+                    *h = radiance / (fraction * ft / exit_norm);
+                }
+            }
+            // Linear interpolation between the bins' centres is not the bins' histogram: scaled
+            // so that the interpolated profile keeps the measured fraction.
+            let interpolated =
+                halfspace::plane_integral(|x| out.node_sd(k, x.length()), 1e-9, 1e3 * reach, 1) * exit_norm;
+            if interpolated > 0.0 && fraction > 0.0 {
+                out.sd[k].iter_mut().for_each(|v| *v *= fraction / interpolated);
+            }
+        }
+        out
+    }
+
+    /// Node `k`'s T as an Sd times reach_k² (dimensionless) at u = ρ/(ρ + reach): linear between
+    /// the entries' centres, held below the first, falling linearly to 0 at u = 1 past the last.
+    pub fn node_scaled(&self, k: usize, u: f64) -> f64 {
+        let x = u * ENTRIES as f64 - 0.5;
+        let reach = reach_mm(self.unit_mm, k);
+        if x <= 0.0 {
+            return self.sd[k][0] * reach * reach;
+        }
+        let i = x.floor() as usize;
+        let f = x - i as f64;
+        let a = self.sd[k][i.min(ENTRIES - 1)];
+        let b = if i + 1 < ENTRIES { self.sd[k][i + 1] } else { 0.0 };
+        (a + (b - a) * f) * reach * reach
+    }
+
+    /// Node `k`'s T as an Sd at lateral distance ρ (mm).
+    pub fn node_sd(&self, k: usize, rho_mm: f64) -> f64 {
+        let reach = reach_mm(self.unit_mm, k);
+        self.node_scaled(k, rho_mm / (rho_mm + reach)) / (reach * reach)
+    }
+
+    /// T(ρ; t) as an Sd (1/mm²), ρ and t in mm (the f64 mirror of bssrdf.glsl's
+    /// `slab_transmission`). Between nodes the profiles are interpolated at the same u =
+    /// ρ/(ρ + reach), reach = t + L, in units of reach² (a profile's width grows with t + L, so
+    /// that is a change of scale between nodes, not a blur of two widths), geometrically in t.
+    pub fn sd(&self, rho_mm: f64, thickness_mm: f64) -> f64 {
+        if thickness_mm.is_nan() || thickness_mm <= 0.0 {
+            return 0.0;
+        }
+        let x = node_coordinate(thickness_mm / self.unit_mm);
+        let last = (THICKNESS_NODES - 1) as f64;
+        if x >= last {
+            return 0.0;
+        }
+        let x = x.max(0.0);
+        let k = (x.floor() as usize).min(THICKNESS_NODES - 2);
+        // Linear in t between the nodes: a thick slab's transmission falls exponentially in t.
+        let (t0, t1) = (node_thickness(k) * self.unit_mm, node_thickness(k + 1) * self.unit_mm);
+        let a = ((thickness_mm - t0) / (t1 - t0)).clamp(0.0, 1.0);
+        let reach = thickness_mm.max(self.unit_mm * node_thickness(0)) + self.unit_mm;
+        let u = rho_mm / (rho_mm + reach);
+        let (v0, v1) = (self.node_scaled(k, u), self.node_scaled(k + 1, u));
+        let v = if v0 > 0.0 && v1 > 0.0 { (v0.ln() + a * (v1 / v0).ln()).exp() } else { v0 + a * (v1 - v0) };
+        v / (reach * reach) * (1.0 - smoothstep(last - 1.0, last, x))
+    }
+
+    /// h_T at thickness t (mm) and exit cosine `cos_o` (outside): linear in t between nodes and,
+    /// in cos²θo, between the bins' centres (held beyond the outer ones).
+    pub fn exit_factor(&self, thickness_mm: f64, cos_o: f64) -> f64 {
+        let x = node_coordinate((thickness_mm / self.unit_mm).max(node_thickness(0)))
+            .clamp(0.0, (THICKNESS_NODES - 1) as f64);
+        let k = (x.floor() as usize).min(THICKNESS_NODES - 2);
+        let (t0, t1) = (node_thickness(k), node_thickness(k + 1));
+        let a = ((thickness_mm / self.unit_mm - t0) / (t1 - t0)).clamp(0.0, 1.0);
+        let y = (cos_o * cos_o * EXIT_BINS as f64 - 0.5).clamp(0.0, (EXIT_BINS - 1) as f64);
+        let j = (y.floor() as usize).min(EXIT_BINS - 2);
+        let at = |k: usize| self.exit[k][j] + (self.exit[k][j + 1] - self.exit[k][j]) * (y - j as f64);
+        at(k) + (at(k + 1) - at(k)) * a
+    }
+}
+
+fn smoothstep(e0: f64, e1: f64, x: f64) -> f64 {
+    let t = ((x - e0) / (e1 - e0)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}
+
+/// L of a material: the longest reduced mean free path of its channels that carry light (mm); 1
+/// where none does.
+pub fn unit_mm(media: &[Medium; 3]) -> f64 {
+    media
+        .iter()
+        .map(|m| (m.sigma_a + m.sigma_s * (1.0 - m.g), m.sigma_s * (1.0 - m.g)))
+        .filter(|&(t, s)| s > 0.0 && t > 0.0)
+        .map(|(t, _)| 1.0 / t)
+        .fold(None, |a: Option<f64>, b| Some(a.map_or(b, |a| a.max(b))))
+        .unwrap_or(1.0)
+}
+
+/// The three channels of a material, measured in parallel with one L.
+pub fn of_channels(media: &[Medium; 3]) -> [Arc<SlabChannel>; 3] {
+    let unit = unit_mm(media);
+    std::thread::scope(|s| {
+        let handles = media.each_ref().map(|m| s.spawn(move || SlabChannel::of(m, unit)));
+        handles.map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+    })
+}
