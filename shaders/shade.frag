@@ -56,7 +56,7 @@ layout(binding = 15) uniform usamplerBuffer point_spread;
 // The same shadow map's depth, unfiltered: how far light travels inside (single scattering).
 layout(binding = 16) uniform sampler2DArray shadow_depth;
 vec4 dipole_header; // its texel 0, read once per pixel
-float slab_unit; // the Monte Carlo table's L (mm), read once per pixel (0 for the other models)
+vec4 slab_header; // the Monte Carlo table's slab header (L in mm, scales), read once per pixel (0 for the other models)
 
 const uint STACK_SIZE = 96u;
 // Points nearer than this many diffusion lengths (1/σtr) of the farthest-reaching channel are
@@ -105,7 +105,7 @@ vec3 across(vec3 xi, vec3 ni, vec3 xo, vec3 no, vec3 sd, vec3 power_mm) {
     if (t <= 0.0) return sd;
     float rho = length(d - t * no);
     w = min(w, 1.0);
-    vec3 through = w * slab_transmission(dipole_table, slab_unit, rho, t) * power_mm;
+    vec3 through = w * slab_transmission(dipole_table, slab_header, rho, t) * power_mm;
     across_sum += through;
     float luminance = dot(through, vec3(0.2126, 0.7152, 0.0722));
     across_thickness += vec2(t * luminance, luminance);
@@ -134,7 +134,7 @@ vec3 source(vec3 xi, vec3 ni, vec3 wi, vec3 power, vec3 xo, vec3 no) {
 // `incident` (PointFlux's sums times the area): the power-weighted sum of the refracted
 // directions, at the source's normal ni, is -(Σωi - (Σωi·ni)ni)/η - ni Σcos θt.
 // `dw` moves every channel's mean refracted direction (a sigma direction, see PointSpread).
-vec3 merged_source(vec3 xi, vec3 ni, vec3 power, vec4 incident[3], vec3 dw, vec3 xo, vec3 no) {
+vec3 merged_source(vec3 xi, vec3 ni, vec3 power, vec4 incident[3], vec3 dw, vec3 xo, vec3 no, bool across_object) {
     float s = object_params.mm_per_unit;
     vec3 sd;
     if (MODEL == MODEL_DIRECTIONAL) {
@@ -153,7 +153,7 @@ vec3 merged_source(vec3 xi, vec3 ni, vec3 power, vec4 incident[3], vec3 dw, vec3
         sd.z = dirpole_channel_sd(object_params.channels[2], with_refracted(g, w[2], no), xi_mm, xo_mm, no);
     } else {
         sd = dipole_sd_table(dipole_table, dipole_header, length(xo - xi) * s);
-        if (MODEL == MODEL_MC) sd = across(xi, ni, xo, no, sd, power * (s * s));
+        if (MODEL == MODEL_MC && across_object) sd = across(xi, ni, xo, no, sd, power * (s * s));
     }
     return sd * power * (s * s); // power is irradiance × scene-unit area: to mm²
 }
@@ -198,7 +198,7 @@ void near_correction(vec3 xi, vec3 ni, float area, vec3 xo, vec3 no, inout uint 
     for (uint c = 0u; c < 3u; ++c) flux[c] = own_incident[c] * (v * area);
     // At the pixel's normal, as the plane integral has it: the pixel's lights refracted at ni
     // would make a different function (near a terminator, lights below ni's horizon).
-    near_sum -= merged_source(x, no, own_irradiance * (v * area), flux, vec3(0.0), xo, no);
+    near_sum -= merged_source(x, no, own_irradiance * (v * area), flux, vec3(0.0), xo, no, false);
 }
 
 // The near field. The few points nearest a pixel sample the BSSRDF's peak at r → 0 badly (the
@@ -278,7 +278,7 @@ vec3 near_field(vec3 xo, vec3 no, out uint made) {
         for (uint a = 0u; a < angles; ++a) {
             float phi = (float(a) + 0.5) * (3.14159265359 / float(angles));
             vec3 xi = xo + (r / s) * (cos(phi) * t1 + sin(phi) * t2);
-            sum += merged_source(xi, no, e * area, flux, vec3(0.0), xo, no);
+            sum += merged_source(xi, no, e * area, flux, vec3(0.0), xo, no, false);
         }
         made += angles;
     }
@@ -316,16 +316,17 @@ vec3 point_evaluated(uint index, vec3 xi, vec3 ni, vec3 power, vec4 incident[3],
     float reach = SIGMA_DIRECTIONS_REACH / min(min(object_params.channels[0].sigma_tr, object_params.channels[1].sigma_tr),
                                                object_params.channels[2].sigma_tr);
     bool near = length(xo - xi) * object_params.mm_per_unit < reach;
-    if ((a0 == vec3(0.0) && a1 == vec3(0.0)) || !near) {
+    // The table models' Sd is radial: the sigma directions would sum to the one evaluation.
+    if (MODEL != MODEL_DIRECTIONAL || (a0 == vec3(0.0) && a1 == vec3(0.0)) || !near) {
         made = 1u;
-        return merged_source(xi, ni, power, incident, vec3(0.0), xo, no);
+        return merged_source(xi, ni, power, incident, vec3(0.0), xo, no, true);
     }
     made = 4u;
     vec3 q = 0.25 * power;
     vec4 iq[3];
     for (uint c = 0u; c < 3u; ++c) iq[c] = 0.25 * incident[c];
-    return merged_source(xi, ni, q, iq, a0, xo, no) + merged_source(xi, ni, q, iq, -a0, xo, no)
-         + merged_source(xi, ni, q, iq, a1, xo, no) + merged_source(xi, ni, q, iq, -a1, xo, no);
+    return merged_source(xi, ni, q, iq, a0, xo, no, true) + merged_source(xi, ni, q, iq, -a0, xo, no, true)
+         + merged_source(xi, ni, q, iq, a1, xo, no, true) + merged_source(xi, ni, q, iq, -a1, xo, no, true);
 }
 
 // The two sources of node `index` used whole: sigma points center ± offset, each with half the
@@ -542,7 +543,7 @@ void main() {
     vec3 xo = surface.xyz;
     vec3 no = normalize(imageLoad(surface_normal, pixel).xyz);
     dipole_header = dipole_table_header(dipole_table);
-    slab_unit = MODEL == MODEL_MC ? slab_unit_mm(dipole_table) : 0.0;
+    slab_header = MODEL == MODEL_MC ? slab_header_of(dipole_table) : vec4(0.0);
     vec3 wo = normalize(pc.eye.xyz - xo);
     vec3 sum = vec3(0.0);
     uint visits = 0u;
@@ -603,8 +604,8 @@ void main() {
             near_correction(center - offset, ni, area, xo, no, evaluations);
             if (power == vec3(0.0)) continue;
             evaluations += 2u;
-            sum += merged_source(center + offset, ni, power, incident, vec3(0.0), xo, no)
-                 + merged_source(center - offset, ni, power, incident, vec3(0.0), xo, no);
+            sum += merged_source(center + offset, ni, power, incident, vec3(0.0), xo, no, true)
+                 + merged_source(center - offset, ni, power, incident, vec3(0.0), xo, no, true);
         }
         visits += tile.z;
         entry += tile.z;
@@ -688,7 +689,7 @@ void main() {
                     evaluations += made;
                 } else {
                     ++evaluations;
-                    sum += merged_source(xi, ni, power, incident, vec3(0.0), xo, no);
+                    sum += merged_source(xi, ni, power, incident, vec3(0.0), xo, no, true);
                 }
             }
         }
@@ -725,7 +726,7 @@ void main() {
         if (across_thickness.y > 0.0) {
             float t = across_thickness.x / across_thickness.y;
             lo += fresnel_transmittance(object_params.channels[0].eta, cos_o) * across_sum
-                * slab_exit_factor(dipole_table, slab_unit, t, cos_o);
+                * slab_exit_factor(dipole_table, slab_header, t, cos_o);
         } else {
             lo += fresnel_transmittance(object_params.channels[0].eta, cos_o) * across_sum;
         }

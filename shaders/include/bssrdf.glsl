@@ -105,42 +105,39 @@ vec3 dipole_sd_table(usamplerBuffer table, vec4 header, float r) { return sd_tab
 
 // The Monte Carlo table's light across an object (mirrors gpu::sd_table::SlabTransmission and
 // physics::slab_profile::SlabChannel::sd): the transmitted profile T(ρ; t) of a flat slab of
-// thickness t as an Sd (1/mm²), ρ and t in mm. After the angular factors: texel SLAB_BASE holds
-// L (mm), then per thickness node k (t_k = L·2^(k/2 − 4)) SLAB_ENTRIES values T·reach_k² at the
-// centres of u = ρ/(ρ + reach), reach = t + L, then per node MC_EXIT_BINS exit factors h_T.
-// Between nodes: the same u, geometric in T·reach², linear in t; below node 0 held; faded to 0
-// over the last half octave.
+// thickness t as an Sd (1/mm²), ρ and t in mm. After the angular factors: texel SLAB_BASE
+// (`header`, read once per pixel) holds L (mm) and the channels' scales, then per lookup node j
+// (t_j = L·2^(j/4 − 4)) SLAB_ENTRIES texels, texel i holding entries i and i + 1 of T·reach_j²
+// per channel as two f16 at the centres of u = ρ/(ρ + reach), reach = t + L, then per measured
+// node (t_k = L·2^(k/2 − 4)) MC_EXIT_BINS exit factors h_T. Between nodes: the same u, linear in
+// log t; below node 0 held; faded to 0 over the last half octave. Two fetches and one log2 per
+// pair (on lavapipe every pair pays for it: both sides of a branch run).
 const int SLAB_BASE = int(DIPOLE_TABLE_SIZE + MC_INCIDENCE_NODES * (1u + MC_EXIT_BINS));
-float slab_unit_mm(usamplerBuffer table) { return uintBitsToFloat(texelFetch(table, SLAB_BASE).x); }
-float slab_node_thickness(float k) { return exp2(0.5 * k + float(SLAB_FIRST_NODE_LOG2_PLUS_8) - 8.0); }
-vec3 slab_node_scaled(usamplerBuffer table, int k, float x) {
-    int base = SLAB_BASE + 1 + k * int(SLAB_ENTRIES);
-    if (x <= 0.0) return uintBitsToFloat(texelFetch(table, base).xyz);
-    float i = floor(x);
-    vec3 a = uintBitsToFloat(texelFetch(table, base + min(int(i), int(SLAB_ENTRIES) - 1)).xyz);
-    vec3 b = int(i) + 1 < int(SLAB_ENTRIES) ? uintBitsToFloat(texelFetch(table, base + int(i) + 1).xyz) : vec3(0.0);
-    return a + (b - a) * (x - i);
+const float SLAB_FIRST_LOG2 = float(SLAB_FIRST_NODE_LOG2_PLUS_8) - 8.0;
+vec4 slab_header_of(usamplerBuffer table) { return uintBitsToFloat(texelFetch(table, SLAB_BASE)); }
+float slab_node_thickness(float k) { return exp2(0.5 * k + SLAB_FIRST_LOG2); }
+vec3 slab_lookup(usamplerBuffer table, int j, float x) {
+    float i = clamp(floor(x), 0.0, float(SLAB_ENTRIES - 1u));
+    float f = clamp(x - i, 0.0, 1.0);
+    uvec3 pairs = texelFetch(table, SLAB_BASE + 1 + j * int(SLAB_ENTRIES) + int(i)).xyz;
+    vec2 red = unpackHalf2x16(pairs.x), green = unpackHalf2x16(pairs.y), blue = unpackHalf2x16(pairs.z);
+    return mix(vec3(red.x, green.x, blue.x), vec3(red.y, green.y, blue.y), f);
 }
-vec3 slab_transmission(usamplerBuffer table, float unit_mm, float rho, float t) {
+vec3 slab_transmission(usamplerBuffer table, vec4 header, float rho, float t) {
+    float unit_mm = header.x;
     if (!(t > 0.0) || !(unit_mm > 0.0)) return vec3(0.0);
-    float x = 2.0 * (log2(t / unit_mm) - (float(SLAB_FIRST_NODE_LOG2_PLUS_8) - 8.0));
-    float last = float(SLAB_THICKNESS_NODES - 1u);
+    float x = 4.0 * (log2(t / unit_mm) - SLAB_FIRST_LOG2);
+    float last = float(SLAB_LOOKUP_NODES - 1u);
     if (x >= last) return vec3(0.0);
     x = max(x, 0.0);
-    float k = min(floor(x), last - 1.0);
-    // One exp2 for both nodes' thicknesses (t1 = √2 t0).
-    float t0 = slab_node_thickness(k) * unit_mm, t1 = t0 * 1.41421356237;
-    float a = clamp((t - t0) / (t1 - t0), 0.0, 1.0);
-    float reach = max(t, slab_node_thickness(0.0) * unit_mm) + unit_mm;
+    float j = min(floor(x), last - 1.0);
+    float reach = max(t, exp2(SLAB_FIRST_LOG2) * unit_mm) + unit_mm;
     float u = rho / (rho + reach) * float(SLAB_ENTRIES) - 0.5;
-    vec3 v0 = slab_node_scaled(table, int(k), u), v1 = slab_node_scaled(table, int(k) + 1, u);
-    bvec3 positive = bvec3(v0.x > 0.0 && v1.x > 0.0, v0.y > 0.0 && v1.y > 0.0, v0.z > 0.0 && v1.z > 0.0);
-    // v0^(1−a) v1^a as v0 · (v1/v0)^a: three logarithms fewer.
-    vec3 geometric = v0 * exp2(a * log2(max(v1, vec3(1e-30)) / max(v0, vec3(1e-30))));
-    vec3 v = mix(v0 + (v1 - v0) * a, geometric, positive);
-    return v / (reach * reach) * (1.0 - smoothstep(last - 1.0, last, x));
+    vec3 v = mix(slab_lookup(table, int(j), u), slab_lookup(table, int(j) + 1, u), x - j);
+    return header.yzw * v / (reach * reach) * (1.0 - smoothstep(last - 2.0, last, x));
 }
-vec3 slab_exit_factor(usamplerBuffer table, float unit_mm, float t, float cos_o) {
+vec3 slab_exit_factor(usamplerBuffer table, vec4 header, float t, float cos_o) {
+    float unit_mm = header.x;
     float tt = max(t / unit_mm, slab_node_thickness(0.0));
     float last = float(SLAB_THICKNESS_NODES - 1u);
     float x = clamp(2.0 * (log2(tt) - (float(SLAB_FIRST_NODE_LOG2_PLUS_8) - 8.0)), 0.0, last);
@@ -149,7 +146,7 @@ vec3 slab_exit_factor(usamplerBuffer table, float unit_mm, float t, float cos_o)
     float a = clamp((tt - t0) / (t1 - t0), 0.0, 1.0);
     float y = clamp(cos_o * cos_o * float(MC_EXIT_BINS) - 0.5, 0.0, float(MC_EXIT_BINS - 1u));
     float j = min(floor(y), float(MC_EXIT_BINS - 2u));
-    int row = SLAB_BASE + 1 + int(SLAB_THICKNESS_NODES * SLAB_ENTRIES) + int(k) * int(MC_EXIT_BINS) + int(j);
+    int row = SLAB_BASE + 1 + int(SLAB_LOOKUP_NODES * SLAB_ENTRIES) + int(k) * int(MC_EXIT_BINS) + int(j);
     vec3 a0 = uintBitsToFloat(texelFetch(table, row).xyz), b0 = uintBitsToFloat(texelFetch(table, row + 1).xyz);
     vec3 a1 = uintBitsToFloat(texelFetch(table, row + int(MC_EXIT_BINS)).xyz);
     vec3 b1 = uintBitsToFloat(texelFetch(table, row + int(MC_EXIT_BINS) + 1).xyz);

@@ -180,19 +180,24 @@ impl AngularFactors {
 }
 
 const _: () = assert!(slab_profile::THICKNESS_NODES == super::SLAB_THICKNESS_NODES as usize);
+const _: () = assert!(slab_profile::LOOKUP_NODES == super::SLAB_LOOKUP_NODES as usize);
 const _: () = assert!(slab_profile::ENTRIES == super::SLAB_ENTRIES as usize);
 const _: () = assert!(slab_profile::FIRST_NODE_LOG2 + 8 == super::SLAB_FIRST_NODE_LOG2_PLUS_8 as i32);
 
 /// The Monte Carlo table's light across an object, after the angular factors in the same buffer
 /// (bssrdf.glsl's `slab_transmission`, `slab_exit_factor`; [`SlabChannel`]): a header texel (L in
-/// mm; 0 for the other models, which never read the rest), then per thickness node its ENTRIES
-/// values T·reach² per channel, then per node its EXIT_BINS exit factors h_T (f32 bits).
+/// mm, then the channels' scales; L = 0 for the other models, which never read the rest), then
+/// per lookup node its ENTRIES texels, texel i holding entries i and i + 1 of T·reach² / scale
+/// per channel as two f16 (as [`SdTable`]: one fetch per node), then per measured node its
+/// EXIT_BINS exit factors h_T (f32 bits).
 #[derive(Clone, Debug, PartialEq)]
 pub struct SlabTransmission {
     pub unit_mm: f32,
-    /// Per node, per entry.
-    pub scaled: Vec<[[f32; 3]; slab_profile::ENTRIES]>,
-    /// Per node, per exit bin.
+    /// Per channel: the largest value / 2^15, so that f16 stays normal down to 2e-9 of it.
+    pub scale: [f32; 3],
+    /// Per lookup node, per entry: f16 bits of T·reach² / scale.
+    pub values: Vec<[[u16; 3]; slab_profile::ENTRIES]>,
+    /// Per measured node, per exit bin.
     pub exit: Vec<[[f32; 3]; slab_profile::EXIT_BINS]>,
 }
 
@@ -201,17 +206,30 @@ impl SlabTransmission {
     pub fn none() -> SlabTransmission {
         SlabTransmission {
             unit_mm: 0.0,
-            scaled: vec![[[0.0; 3]; slab_profile::ENTRIES]; slab_profile::THICKNESS_NODES],
+            scale: [0.0; 3],
+            values: vec![[[0; 3]; slab_profile::ENTRIES]; slab_profile::LOOKUP_NODES],
             exit: vec![[[1.0; 3]; slab_profile::EXIT_BINS]; slab_profile::THICKNESS_NODES],
         }
     }
 
     pub fn monte_carlo(channels: &[std::sync::Arc<SlabChannel>; 3]) -> SlabTransmission {
-        let centre = |i: usize| (i as f64 + 0.5) / slab_profile::ENTRIES as f64;
+        let scale = [0, 1, 2].map(|c| {
+            let peak = channels[c].lookup.iter().flatten().fold(0.0f64, |a, &b| a.max(b));
+            if peak > 0.0 {
+                (peak / 32768.0) as f32
+            } else {
+                1.0
+            }
+        });
         SlabTransmission {
             unit_mm: channels[0].unit_mm as f32,
-            scaled: (0..slab_profile::THICKNESS_NODES)
-                .map(|k| std::array::from_fn(|i| [0, 1, 2].map(|c| channels[c].node_scaled(k, centre(i)) as f32)))
+            scale,
+            values: (0..slab_profile::LOOKUP_NODES)
+                .map(|j| {
+                    std::array::from_fn(|i| {
+                        [0, 1, 2].map(|c| half_bits((channels[c].lookup[j][i] / scale[c] as f64) as f32))
+                    })
+                })
                 .collect(),
             exit: (0..slab_profile::THICKNESS_NODES)
                 .map(|k| std::array::from_fn(|b| [0, 1, 2].map(|c| channels[c].exit[k][b] as f32)))
@@ -219,15 +237,28 @@ impl SlabTransmission {
         }
     }
 
+    /// T·reach² of lookup node `j`, entry `i`, channel `c`, as the shader reads it.
+    pub fn value(&self, j: usize, i: usize, c: usize) -> f64 {
+        self.scale[c] as f64 * half_value(self.values[j][i][c])
+    }
+
     pub fn texels(&self) -> Vec<[u32; 4]> {
-        let header = std::iter::once([self.unit_mm, 0.0, 0.0, 0.0].map(f32::to_bits));
-        let scaled = self.scaled.iter().flatten().map(|v| [v[0], v[1], v[2], 0.0].map(f32::to_bits));
+        let header = std::iter::once([self.unit_mm, self.scale[0], self.scale[1], self.scale[2]].map(f32::to_bits));
+        let pairs = self.values.iter().flat_map(|node| {
+            (0..slab_profile::ENTRIES).map(move |i| {
+                let next = |c: usize| if i + 1 < slab_profile::ENTRIES { node[i + 1][c] } else { 0 };
+                let pair = |c: usize| node[i][c] as u32 | (next(c) as u32) << 16;
+                [pair(0), pair(1), pair(2), 0]
+            })
+        });
         let exit = self.exit.iter().flatten().map(|h| [h[0], h[1], h[2], 0.0].map(f32::to_bits));
-        header.chain(scaled).chain(exit).collect()
+        header.chain(pairs).chain(exit).collect()
     }
 
     /// Texels after the angular factors.
-    pub const TEXELS: usize = 1 + slab_profile::THICKNESS_NODES * (slab_profile::ENTRIES + slab_profile::EXIT_BINS);
+    pub const TEXELS: usize = 1
+        + slab_profile::LOOKUP_NODES * slab_profile::ENTRIES
+        + slab_profile::THICKNESS_NODES * slab_profile::EXIT_BINS;
 }
 
 /// Beam diffusion's entry at `r` of a table of `reach`: Sd, but at r = 0 the v0 for which the
@@ -384,5 +415,32 @@ mod tests {
                 assert!((tabulated / exact - 1.0).abs() < 2e-3, "{name} channel {c}: {tabulated} vs {exact}");
             }
         }
+    }
+
+    /// The slab's lookup as the shader reads it (f16 over a per-channel scale) against its f64
+    /// values: within 1e-3 of each value from 1e-6 of the channel's peak on, and the texels lay
+    /// entry i + 1 beside entry i.
+    #[test]
+    fn slab_lookup_keeps_its_values_in_f16() {
+        let material = crate::materials::Material::find("skin1").unwrap();
+        let channels = slab_profile::of_channels(&[0, 1, 2].map(|c| material.channel(c)));
+        let gpu = SlabTransmission::monte_carlo(&channels);
+        for (c, channel) in channels.iter().enumerate() {
+            let peak = channel.lookup.iter().flatten().fold(0.0f64, |a, &b| a.max(b));
+            assert!(peak > 0.0);
+            for j in 0..slab_profile::LOOKUP_NODES {
+                for i in 0..slab_profile::ENTRIES {
+                    let (exact, got) = (channel.lookup[j][i], gpu.value(j, i, c));
+                    if exact > 1e-6 * peak {
+                        assert!((got / exact - 1.0).abs() < 1e-3, "channel {c} node {j} entry {i}: {got} vs {exact}");
+                    }
+                }
+            }
+        }
+        let texels = gpu.texels();
+        assert_eq!(texels.len(), SlabTransmission::TEXELS);
+        let pair = texels[1 + 5]; // lookup node 0, entry 5
+        assert_eq!(pair[0] & 0xffff, gpu.values[0][5][0] as u32);
+        assert_eq!(pair[0] >> 16, gpu.values[0][6][0] as u32);
     }
 }

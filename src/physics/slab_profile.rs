@@ -35,6 +35,10 @@ use std::sync::{Arc, Mutex, OnceLock};
 /// the interpolation between them lost up to 14% of Skin1's blue through 2 mm).
 pub const THICKNESS_NODES: usize = 22;
 pub const FIRST_NODE_LOG2: i32 = -4;
+/// The nodes the lookup reads, a quarter octave apart (2 × THICKNESS_NODES − 1: the measured ones
+/// and, between each two, their geometric interpolation), so that the shade pass interpolates
+/// linearly, with no logarithm or exponential per pair but the thickness's log2.
+pub const LOOKUP_NODES: usize = 2 * THICKNESS_NODES - 1;
 /// Bins of the transmitted exit distribution h_T, equal in cos²θo outside (as
 /// [`super::mc_profile::EXIT_BINS`]).
 pub const EXIT_BINS: usize = super::mc_profile::EXIT_BINS;
@@ -60,6 +64,16 @@ pub fn node_thickness(k: usize) -> f64 {
     2f64.powf(k as f64 / 2.0 + FIRST_NODE_LOG2 as f64)
 }
 
+/// The centre of radial entry `i` in u.
+pub fn entry_centre(i: usize) -> f64 {
+    (i as f64 + 0.5) / ENTRIES as f64
+}
+
+/// The lookup coordinate of thickness t (units of L): j at lookup node j (t = 2^(j/4 − 4)).
+pub fn lookup_coordinate(thickness: f64) -> f64 {
+    4.0 * (thickness.log2() - FIRST_NODE_LOG2 as f64)
+}
+
 /// The node coordinate of thickness t (units of L): k at node k.
 pub fn node_coordinate(thickness: f64) -> f64 {
     2.0 * (thickness.log2() - FIRST_NODE_LOG2 as f64)
@@ -76,6 +90,9 @@ pub struct SlabChannel {
     /// Per node, per entry: T as an Sd, the exitance per unit power entering over the lobe's
     /// ∫Ft cos θ dω (1/mm²).
     pub sd: Vec<[f64; ENTRIES]>,
+    /// Per lookup node (thickness L · 2^(j/4 − 4)), per entry: T·reach_j² at the entries' centres,
+    /// reach_j = t_j + L (what the shade pass reads, [`SlabChannel::sd`]).
+    pub lookup: Vec<[f64; ENTRIES]>,
     /// Per node, per exit bin: h_T, the transmitted radiance per unit transmitted exitance over
     /// the lobe Ft(θo)/∫Ft cos θ dω (1 where the lobe is exact).
     pub exit: Vec<[f64; EXIT_BINS]>,
@@ -116,6 +133,7 @@ impl SlabChannel {
             unit_mm,
             transmitted: [0.0; THICKNESS_NODES],
             sd: vec![[0.0; ENTRIES]; THICKNESS_NODES],
+            lookup: vec![[0.0; ENTRIES]; LOOKUP_NODES],
             exit: vec![[1.0; EXIT_BINS]; THICKNESS_NODES],
         };
         if !(sigma_s_reduced > 0.0 && sigma_t > 0.0 && unit_mm > 0.0 && unit_mm.is_finite()) {
@@ -177,7 +195,41 @@ impl SlabChannel {
                 out.sd[k].iter_mut().for_each(|v| *v *= fraction / interpolated);
             }
         }
+        out.lookup =
+            (0..LOOKUP_NODES).map(|j| std::array::from_fn(|i| out.measured_scaled(j, entry_centre(i)))).collect();
         out
+    }
+
+    /// The measured nodes' T·reach² at lookup node `j` and u: node j/2 itself for even j; between
+    /// two (odd j) at the same u, geometrically in value and linearly in t (a thick slab's
+    /// transmission falls exponentially in t; an octave between measured nodes instead of half
+    /// lost 14% of Skin1's blue through 2 mm).
+    fn measured_scaled(&self, j: usize, u: f64) -> f64 {
+        let k = j / 2;
+        if j.is_multiple_of(2) {
+            return self.node_scaled(k, u);
+        }
+        let a = (2f64.powf(0.25) - 1.0) / (2f64.sqrt() - 1.0);
+        let (v0, v1) = (self.node_scaled(k, u), self.node_scaled(k + 1, u));
+        if v0 > 0.0 && v1 > 0.0 {
+            (v0.ln() + a * (v1 / v0).ln()).exp()
+        } else {
+            v0 + a * (v1 - v0)
+        }
+    }
+
+    /// Lookup node `j`'s T·reach² at u: linear between the entries' centres, held below the first,
+    /// falling linearly to 0 at u = 1 past the last (as [`SlabChannel::node_scaled`]).
+    pub fn lookup_scaled(&self, j: usize, u: f64) -> f64 {
+        let x = u * ENTRIES as f64 - 0.5;
+        if x <= 0.0 {
+            return self.lookup[j][0];
+        }
+        let i = x.floor() as usize;
+        let f = x - i as f64;
+        let a = self.lookup[j][i.min(ENTRIES - 1)];
+        let b = if i + 1 < ENTRIES { self.lookup[j][i + 1] } else { 0.0 };
+        a + (b - a) * f
     }
 
     /// Node `k`'s T as an Sd times reach_k² (dimensionless) at u = ρ/(ρ + reach): linear between
@@ -202,28 +254,25 @@ impl SlabChannel {
     }
 
     /// T(ρ; t) as an Sd (1/mm²), ρ and t in mm (the f64 mirror of bssrdf.glsl's
-    /// `slab_transmission`). Between nodes the profiles are interpolated at the same u =
-    /// ρ/(ρ + reach), reach = t + L, in units of reach² (a profile's width grows with t + L, so
-    /// that is a change of scale between nodes, not a blur of two widths), geometrically in t.
+    /// `slab_transmission`): between lookup nodes, at the same u = ρ/(ρ + reach), reach = t + L, in
+    /// units of reach² (a profile's width grows with t + L, so that is a change of scale between
+    /// nodes, not a blur of two widths), linearly in log t; faded to 0 over the last half octave.
     pub fn sd(&self, rho_mm: f64, thickness_mm: f64) -> f64 {
         if thickness_mm.is_nan() || thickness_mm <= 0.0 {
             return 0.0;
         }
-        let x = node_coordinate(thickness_mm / self.unit_mm);
-        let last = (THICKNESS_NODES - 1) as f64;
+        let x = lookup_coordinate(thickness_mm / self.unit_mm);
+        let last = (LOOKUP_NODES - 1) as f64;
         if x >= last {
             return 0.0;
         }
         let x = x.max(0.0);
-        let k = (x.floor() as usize).min(THICKNESS_NODES - 2);
-        // Linear in t between the nodes: a thick slab's transmission falls exponentially in t.
-        let (t0, t1) = (node_thickness(k) * self.unit_mm, node_thickness(k + 1) * self.unit_mm);
-        let a = ((thickness_mm - t0) / (t1 - t0)).clamp(0.0, 1.0);
+        let j = (x.floor() as usize).min(LOOKUP_NODES - 2);
+        let a = x - j as f64;
         let reach = thickness_mm.max(self.unit_mm * node_thickness(0)) + self.unit_mm;
         let u = rho_mm / (rho_mm + reach);
-        let (v0, v1) = (self.node_scaled(k, u), self.node_scaled(k + 1, u));
-        let v = if v0 > 0.0 && v1 > 0.0 { (v0.ln() + a * (v1 / v0).ln()).exp() } else { v0 + a * (v1 - v0) };
-        v / (reach * reach) * (1.0 - smoothstep(last - 1.0, last, x))
+        let (v0, v1) = (self.lookup_scaled(j, u), self.lookup_scaled(j + 1, u));
+        (v0 + (v1 - v0) * a) / (reach * reach) * (1.0 - smoothstep(last - 2.0, last, x))
     }
 
     /// h_T at thickness t (mm) and exit cosine `cos_o` (outside): linear in t between nodes and,
