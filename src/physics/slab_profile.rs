@@ -221,30 +221,14 @@ impl SlabChannel {
     /// Lookup node `j`'s T·reach² at u: linear between the entries' centres, held below the first,
     /// falling linearly to 0 at u = 1 past the last (as [`SlabChannel::node_scaled`]).
     pub fn lookup_scaled(&self, j: usize, u: f64) -> f64 {
-        let x = u * ENTRIES as f64 - 0.5;
-        if x <= 0.0 {
-            return self.lookup[j][0];
-        }
-        let i = x.floor() as usize;
-        let f = x - i as f64;
-        let a = self.lookup[j][i.min(ENTRIES - 1)];
-        let b = if i + 1 < ENTRIES { self.lookup[j][i + 1] } else { 0.0 };
-        a + (b - a) * f
+        between_entries(&self.lookup[j], u)
     }
 
     /// Node `k`'s T as an Sd times reach_k² (dimensionless) at u = ρ/(ρ + reach): linear between
     /// the entries' centres, held below the first, falling linearly to 0 at u = 1 past the last.
     pub fn node_scaled(&self, k: usize, u: f64) -> f64 {
-        let x = u * ENTRIES as f64 - 0.5;
         let reach = reach_mm(self.unit_mm, k);
-        if x <= 0.0 {
-            return self.sd[k][0] * reach * reach;
-        }
-        let i = x.floor() as usize;
-        let f = x - i as f64;
-        let a = self.sd[k][i.min(ENTRIES - 1)];
-        let b = if i + 1 < ENTRIES { self.sd[k][i + 1] } else { 0.0 };
-        (a + (b - a) * f) * reach * reach
+        between_entries(&self.sd[k], u) * reach * reach
     }
 
     /// Node `k`'s T as an Sd at lateral distance ρ (mm).
@@ -288,6 +272,20 @@ impl SlabChannel {
         let at = |k: usize| self.exit[k][j] + (self.exit[k][j + 1] - self.exit[k][j]) * (y - j as f64);
         at(k) + (at(k + 1) - at(k)) * a
     }
+}
+
+/// `entries` at u: linear between their centres, held below the first, falling linearly to 0 at
+/// u = 1 past the last (bssrdf.glsl's `slab_lookup`).
+fn between_entries(entries: &[f64; ENTRIES], u: f64) -> f64 {
+    let x = u * ENTRIES as f64 - 0.5;
+    if x <= 0.0 {
+        return entries[0];
+    }
+    let i = x.floor() as usize;
+    let f = x - i as f64;
+    let a = entries[i.min(ENTRIES - 1)];
+    let b = if i + 1 < ENTRIES { entries[i + 1] } else { 0.0 };
+    a + (b - a) * f
 }
 
 fn smoothstep(e0: f64, e1: f64, x: f64) -> f64 {
