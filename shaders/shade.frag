@@ -25,6 +25,9 @@
 // model chosen at run time would cost both models' arithmetic (measured: the classical dipole
 // took 2.4x longer beside the directional one's dead code).
 layout(constant_id = 0) const uint MODEL = 0u; // 0 directional dipole, 1 classical dipole, 2 beam diffusion, 3 Monte Carlo table (1-3: table)
+// Whether the near field is split off (see near_field()), fixed per pipeline for the same reason:
+// a frame without it pays nothing for its code.
+layout(constant_id = 1) const bool NEAR_FIELD = false;
 
 layout(location = 0) out vec4 radiance;
 
@@ -75,8 +78,15 @@ const uint MAX_STEPS = 32768u;
 vec3 own_irradiance;
 vec4 own_incident[3];
 bool own_lit = false;
-// The control variate's sum (near_correction()).
+// The control variate's light: the pixel's own irradiance and flux where it is lit, else a unit
+// irradiance at normal incidence, so that the variate's share (near_blend in main) is known at
+// every pixel, from the geometry alone (set by own_light()).
+vec3 variate_irradiance;
+vec4 variate_incident[3];
+// The control variate's sum, −Σ v_i Sd_i A_i under the variate's light (near_correction()), and
+// Σ v_i f_i, the sources' own contributions weighted by the same v_i (near_blend in main).
 vec3 near_sum = vec3(0.0);
+vec3 near_sources = vec3(0.0);
 // Sources whose normal turns further than this from the pixel's (ni·no below it: the far side
 // of a sheet thinner than the near field's reach) are no part of the pixel's tangent plane,
 // unfolded or not, and stay out of the control variate.
@@ -187,18 +197,25 @@ vec3 unfolded(vec3 xi, vec3 ni, vec3 xo, vec3 no) {
 // The near field's control variate at a source of `area` (scene units²) at xi, ni, whether lit
 // or not: −(1 − w) times that area, unfolded into the pixel's tangent plane (unfolded()), lit
 // by the pixel's own irradiance and lights (see near_field()); `made` counts the evaluations.
-// Adds to near_sum.
-void near_correction(vec3 xi, vec3 ni, float area, vec3 xo, vec3 no, inout uint made) {
-    if (!own_lit || dot(ni, no) < NEAR_UNFOLD_MIN_COS) return;
+// Adds to near_sum; returns v, the source's weight in it (0 beyond reach).
+float near_correction(vec3 xi, vec3 ni, float area, vec3 xo, vec3 no, inout uint made) {
+    if (!NEAR_FIELD || dot(ni, no) < NEAR_UNFOLD_MIN_COS) return 0.0;
     vec3 x = unfolded(xi, ni, xo, no);
-    float v = near_weight(x, xo);
-    if (v <= 0.0) return;
+    // A fold carries a source no nearer than it lies (the way through the fold is no shorter
+    // than the straight line), so an unfolded place nearer than the source itself is no fold:
+    // a far source whose tangent plane meets the pixel's near the pixel, turned onto the pixel.
+    // Such a source (a node's sigma point across the object, 7-19 mm away on the bunny) made
+    // 75-99% of the points' estimate at every negative pixel, 7-140x the integral it estimates.
+    // It is weighed at its own distance, which leaves it out.
+    float v = min(near_weight(x, xo), near_weight(xi, xo));
+    if (v <= 0.0) return 0.0;
     ++made;
     vec4 flux[3];
-    for (uint c = 0u; c < 3u; ++c) flux[c] = own_incident[c] * (v * area);
+    for (uint c = 0u; c < 3u; ++c) flux[c] = variate_incident[c] * (v * area);
     // At the pixel's normal, as the plane integral has it: the pixel's lights refracted at ni
     // would make a different function (near a terminator, lights below ni's horizon).
-    near_sum -= merged_source(x, no, own_irradiance * (v * area), flux, vec3(0.0), xo, no, false);
+    near_sum -= merged_source(x, no, variate_irradiance * (v * area), flux, vec3(0.0), xo, no, false);
+    return v;
 }
 
 // The near field. The few points nearest a pixel sample the BSSRDF's peak at r → 0 badly (the
@@ -213,6 +230,11 @@ void near_correction(vec3 xi, vec3 ni, float area, vec3 xo, vec3 no, inout uint 
 // of the last term, so the two cancel but for the points' error in it: what remains sampled is
 // Sd · (E_i − E(xo)), which vanishes at the peak where E is smooth, and is the plain point sum
 // where it is not (shadow edges, terminators), so brute force's expectation is kept everywhere.
+// Where the points oversample the peak (their estimate Σ v_i Sd_i A_i above the integral G), the
+// variate alone can make a pixel negative wherever E_i < E(xo) (a shadow's or terminator's
+// edge); there main() blends it (γ) toward Σ (1 − v_i) f_i + E(xo) G, the peak taken from the
+// pixel's own irradiance alone, which has the same expectation where E is smooth and only
+// non-negative coefficients (see near_blend in main).
 // The integral is a fixed quadrature over the disk (this function). Radially: Gauss–Legendre on
 // [0, start] in t, r = scale · sinh t (r dr = scale² sinh t cosh t dt: smooth where Sd peaks
 // over ~D, and where Sd ~ 1/r for beam diffusion's single scattering), and on [start, end],
@@ -241,13 +263,15 @@ void own_light(vec3 xo, vec3 no) {
         own_irradiance += e;
     }
     own_lit = own_irradiance != vec3(0.0);
+    variate_irradiance = own_lit ? own_irradiance : vec3(1.0);
+    vec4 normal_incidence = flux_term(no, no);
+    for (uint c = 0u; c < 3u; ++c) variate_incident[c] = own_lit ? own_incident[c] : normal_incidence;
 }
 
 vec3 near_field(vec3 xo, vec3 no, out uint made) {
     made = 0u;
-    if (!own_lit) return vec3(0.0);
-    vec3 e = own_irradiance;
-    vec4 incident[3] = own_incident;
+    vec3 e = variate_irradiance;
+    vec4 incident[3] = variate_incident;
     vec3 toward_mean = incident[0].xyz * 0.2126 + incident[1].xyz * 0.7152 + incident[2].xyz * 0.0722;
     float s = object_params.mm_per_unit;
     float start = object_params.near_start_mm, end = object_params.near_end_mm, scale = object_params.near_scale_mm;
@@ -550,7 +574,7 @@ void main() {
     uint evaluated = 0u;
     uint evaluations = 0u;
     uint light_count = light_set.light_count;
-    if (frame_params.near_field != 0u) own_light(xo, no);
+    if (NEAR_FIELD) own_light(xo, no);
     if (frame_params.brute_force != 0u || object_params.node_count == 0u) {
         // One draw per range of (point, light) records, added by blending: llvmpipe (lavapipe)
         // silently ends a shader invocation's loops after ~65k iterations in total, so no draw
@@ -560,7 +584,7 @@ void main() {
         for (uint r = pc.point_range.x; r < end; ++r) {
             sum += point_light_source(r, light_count, xo, no);
             // The near field's control variate, once per point (with --near-field on).
-            if (own_lit && r % light_count == 0u) {
+            if (r % light_count == 0u) {
                 uint point = r / light_count;
                 vec4 position_area = texel_float(points, point * POINT_TEXELS);
                 vec3 ni = texel_float(points, point * POINT_TEXELS + 1u).xyz;
@@ -584,10 +608,12 @@ void main() {
             point_source(index, xi, power, incident, area);
             vec3 ni = texel_float(points, index * POINT_TEXELS + 1u).xyz;
             // Unlit points are listed only within the near field's reach, for its control variate.
-            near_correction(xi, ni, area, xo, no, evaluations);
+            float v = near_correction(xi, ni, area, xo, no, evaluations);
             if (power == vec3(0.0)) continue;
             uint made;
-            sum += point_evaluated(index, xi, ni, power, incident, xo, no, made);
+            vec3 f = point_evaluated(index, xi, ni, power, incident, xo, no, made);
+            sum += f;
+            near_sources += v * f;
             evaluations += made;
         }
         evaluated += tile.y;
@@ -600,12 +626,14 @@ void main() {
             vec4 incident[3];
             float area;
             node_sigma(index, ni, xo, center, offset, power, incident, area);
-            near_correction(center + offset, ni, area, xo, no, evaluations);
-            near_correction(center - offset, ni, area, xo, no, evaluations);
+            float v_plus = near_correction(center + offset, ni, area, xo, no, evaluations);
+            float v_minus = near_correction(center - offset, ni, area, xo, no, evaluations);
             if (power == vec3(0.0)) continue;
             evaluations += 2u;
-            sum += merged_source(center + offset, ni, power, incident, vec3(0.0), xo, no, true)
-                 + merged_source(center - offset, ni, power, incident, vec3(0.0), xo, no, true);
+            vec3 f_plus = merged_source(center + offset, ni, power, incident, vec3(0.0), xo, no, true);
+            vec3 f_minus = merged_source(center - offset, ni, power, incident, vec3(0.0), xo, no, true);
+            sum += f_plus + f_minus;
+            near_sources += v_plus * f_plus + v_minus * f_minus;
         }
         visits += tile.z;
         entry += tile.z;
@@ -639,7 +667,7 @@ void main() {
                         ++evaluated;
                         // Unlit: only the near field's control variate needs it.
                         if (texel_float(points, index * POINT_TEXELS + 2u).xyz == vec3(0.0)
-                            && !(own_lit && near_weight(texel_float(points, index * POINT_TEXELS).xyz, xo) > 0.0))
+                            && !(NEAR_FIELD && near_weight(texel_float(points, index * POINT_TEXELS).xyz, xo) > 0.0))
                             continue;
                     }
                 } else {
@@ -653,7 +681,7 @@ void main() {
                         vec3 lo, hi;
                         unpack_box(box_right.xyz, lo, hi);
                         // Unlit: only the near field's control variate needs it, within its reach.
-                        if (power_area.xyz == vec3(0.0) && !(own_lit && within_near_reach(xo, lo, hi))) continue;
+                        if (power_area.xyz == vec3(0.0) && !(NEAR_FIELD && within_near_reach(xo, lo, hi))) continue;
                         vec3 d = uintBitsToFloat(center_left.xyz) - xo;
                         bool inside = all(greaterThanEqual(xo, lo)) && all(lessThanEqual(xo, hi));
                         // A full stack or a spent step budget (see above) ends the descent: the
@@ -681,25 +709,46 @@ void main() {
                     node_sigma(index, ni, xo, xi, offset, power, incident, area);
                     xi += evaluation != 0u ? -offset : offset;
                 }
-                near_correction(xi, ni, area, xo, no, evaluations);
+                float v = near_correction(xi, ni, area, xo, no, evaluations);
                 if (power == vec3(0.0)) continue;
+                vec3 f;
                 if (is_point) {
                     uint made;
-                    sum += point_evaluated(index, xi, ni, power, incident, xo, no, made);
+                    f = point_evaluated(index, xi, ni, power, incident, xo, no, made);
                     evaluations += made;
                 } else {
                     ++evaluations;
-                    sum += merged_source(xi, ni, power, incident, vec3(0.0), xo, no, true);
+                    f = merged_source(xi, ni, power, incident, vec3(0.0), xo, no, true);
                 }
+                sum += f;
+                near_sources += v * f;
             }
         }
     }
     // The near field, once: by the first of several brute-force draws.
-    if (frame_params.near_field != 0u) {
+    if (NEAR_FIELD) {
         uint made = 0u;
         vec3 integral = pc.point_range.x == 0u ? near_field(xo, no, made) : vec3(0.0);
         evaluations += made;
-        sum += near_sum + integral;
+        // near_blend: the blend γ per channel between the control variate (γ = 0) and taking the peak from
+        // the pixel's own irradiance alone (γ = 1), see near_field(): the least γ that keeps the
+        // pixel's own-irradiance coefficient G − (1 − γ) Σg non-negative, so no pixel can be
+        // negative whatever its lights. Both ends expect the same where E is smooth; γ > 0 only
+        // where the points oversample the peak (Σg > G: a point a small fraction of a spacing
+        // from the pixel), which is exactly where the variate alone went negative at a shadow's
+        // or terminator's edge. It is a ratio of two sums under the same light: the geometry's
+        // alone but for the directional dipole's mean direction, so the image stays linear in
+        // the lights. Brute force's draws each see part of the points, so it keeps γ = 0.
+        bool tree = frame_params.brute_force == 0u && object_params.node_count != 0u;
+        vec3 points_estimate = -near_sum;
+        vec3 blend = vec3(0.0);
+        for (uint c = 0u; c < 3u; ++c) {
+            if (tree && points_estimate[c] > integral[c]) blend[c] = 1.0 - integral[c] / points_estimate[c];
+        }
+        sum -= blend * near_sources;
+        // The variate's own-irradiance term, where the pixel is lit (an unlit pixel's variate
+        // light is only there for the blend).
+        if (own_lit) sum += integral - (1.0 - blend) * points_estimate;
     }
     // Helper invocations' atomics have no effect (Vulkan spec), so only real pixels count.
     if (frame_params.count_work != 0u) {
@@ -721,7 +770,7 @@ void main() {
     // The Monte Carlo table's exit distribution (the others' lobe is Ft alone).
     if (MODEL == MODEL_MC) {
         // The pixel's own flux: already there where the near field needed it.
-        if (frame_params.near_field == 0u) own_light(xo, no);
+        if (!NEAR_FIELD) own_light(xo, no);
         lo *= table_exit_factor(dipole_table, own_cos_t(), cos_o);
         if (across_thickness.y > 0.0) {
             float t = across_thickness.x / across_thickness.y;

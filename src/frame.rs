@@ -534,7 +534,7 @@ impl Renderer {
             ShadeConstants { view_projection, eye: desc.camera.eye.extend(1.0), point_range: glam::UVec4::ZERO };
         let shading = desc.show == Show::Shading;
         if shading {
-            self.passes.shade.prepare(&self.ctx, integration.model, integration.brute_force)?;
+            self.passes.shade.prepare(&self.ctx, shade_variant(&integration), integration.brute_force)?;
         }
         let cut = shading && !integration.brute_force;
         let objects = self.world.objects.len();
@@ -643,7 +643,7 @@ impl Renderer {
     pub fn shade_some(&mut self, frame: &mut FrameInProgress, budget: Option<std::time::Duration>) -> Result<bool> {
         self.check_current(frame)?;
         let inputs: Vec<ShadeInputs> = (0..self.world.objects.len()).map(|k| shade_inputs!(self, k)).collect();
-        let (constants, model) = (frame.constants, frame.desc.integration.model);
+        let (constants, variant) = (frame.constants, shade_variant(&frame.desc.integration));
         let started = std::time::Instant::now();
         // Shading in several submissions, so that none runs long (see src/batching.rs).
         let units = &frame.units;
@@ -656,7 +656,7 @@ impl Renderer {
             self.ctx.submit(self.profiler.as_mut(), |rec| {
                 rec.scope("shade", |rec| {
                     batch.iter().try_for_each(|unit| {
-                        self.passes.shade.record_unit(rec, &inputs[unit.object as usize], &constants, unit, model)
+                        self.passes.shade.record_unit(rec, &inputs[unit.object as usize], &constants, unit, variant)
                     })
                 })
             })?;
@@ -780,4 +780,9 @@ impl Targets {
         )?;
         Ok(Targets { extent, color, depth, position, normal, albedo, readback, ldr })
     }
+}
+
+/// The shade pass's pipeline for a frame integrated as `integration`.
+fn shade_variant(integration: &crate::frame_desc::Integration) -> crate::passes::shade::ShadeVariant {
+    crate::passes::shade::ShadeVariant { model: integration.model, near_field: integration.splits_near_field() }
 }

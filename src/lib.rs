@@ -17,6 +17,7 @@ pub mod frame_desc;
 pub mod gpu;
 pub mod gpu_world;
 pub mod hierarchy;
+pub mod image_quality;
 pub mod materials;
 pub mod mesh;
 pub mod models;

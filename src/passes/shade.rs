@@ -110,9 +110,9 @@ pub struct ShadePass {
     surface: Pipeline,
     /// The opaque objects' meshes, with their reflectance.
     surface_diffuse: Pipeline,
-    /// Shading per model and blending (additive for brute force in several draws), made on
+    /// Shading per variant and blending (additive for brute force in several draws), made on
     /// first use.
-    shading: HashMap<(Model, bool), Pipeline>,
+    shading: HashMap<(ShadeVariant, bool), Pipeline>,
 }
 
 /// Bytes per vertex: position and normal, 3 floats each.
@@ -145,8 +145,25 @@ pub fn full_screen_pipeline(
     )
 }
 
-fn shading_pipeline(ctx: &Context, model: Model, additive_blend: bool) -> Result<Pipeline> {
-    full_screen_pipeline(ctx, "shade.frag", additive_blend, &[model.gpu_code()])
+/// What the shade pass's pipeline is specialised for (shade.frag's specialisation constants):
+/// llvmpipe runs both sides of every branch, so a feature chosen by a uniform would cost every
+/// pixel its code even where it is off.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct ShadeVariant {
+    pub model: Model,
+    /// The near field split off (`--near-field`).
+    pub near_field: bool,
+}
+
+impl ShadeVariant {
+    /// The specialisation constants, in constant_id order.
+    fn specialization(&self) -> [u32; 2] {
+        [self.model.gpu_code(), self.near_field as u32]
+    }
+}
+
+fn shading_pipeline(ctx: &Context, variant: ShadeVariant, additive_blend: bool) -> Result<Pipeline> {
+    full_screen_pipeline(ctx, "shade.frag", additive_blend, &variant.specialization())
 }
 
 /// A mesh (positions and normals) to the G-buffer, depth-tested, through `vertex_shader` and
@@ -178,12 +195,12 @@ impl ShadePass {
         Ok(ShadePass { surface, surface_diffuse, shading: HashMap::new() })
     }
 
-    /// Makes the shading pipeline of `model` (and its additive twin for brute force) if not made
-    /// yet: each is a compilation on llvmpipe, so only what a frame uses is made.
-    pub fn prepare(&mut self, ctx: &Context, model: Model, brute_force: bool) -> Result<()> {
+    /// Makes the shading pipeline of `variant` (and its additive twin for brute force) if not
+    /// made yet: each is a compilation on llvmpipe, so only what a frame uses is made.
+    pub fn prepare(&mut self, ctx: &Context, variant: ShadeVariant, brute_force: bool) -> Result<()> {
         for additive in [false, true].into_iter().take(1 + brute_force as usize) {
-            if let std::collections::hash_map::Entry::Vacant(slot) = self.shading.entry((model, additive)) {
-                slot.insert(shading_pipeline(ctx, model, additive)?);
+            if let std::collections::hash_map::Entry::Vacant(slot) = self.shading.entry((variant, additive)) {
+                slot.insert(shading_pipeline(ctx, variant, additive)?);
             }
         }
         Ok(())
@@ -238,7 +255,7 @@ impl ShadePass {
         inputs: &ShadeInputs,
         constants: &ShadeConstants,
         unit: &ShadeUnit,
-        model: Model,
+        variant: ShadeVariant,
     ) -> Result<()> {
         let binds = [
             Bind::Uniform(inputs.object_params),
@@ -264,8 +281,8 @@ impl ShadePass {
         let additive = unit.point_count > 0;
         let pipeline = self
             .shading
-            .get(&(model, additive))
-            .ok_or_else(|| crate::runtime!("shade: the pipeline of the {} model was not prepared", model.name()))?;
+            .get(&(variant, additive))
+            .ok_or_else(|| crate::runtime!("shade: the pipeline of {variant:?} was not prepared"))?;
         // One rendering scope per unit: every draw writes the work counters, and the barrier
         // between two writes cannot sit inside a rendering scope.
         rec.prepare_draw_reads(&binds)?;
