@@ -546,9 +546,13 @@ pub(crate) fn rgb(s: &str) -> std::result::Result<Vec3, String> {
 pub fn usage_exit(e: clap::Error) -> i32 {
     use clap::error::ErrorKind;
     match e.kind() {
+        // Help that cannot be written is a failure named like every other write to stdout.
         ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => match e.print() {
             Ok(()) => 0,
-            Err(_) => 1,
+            Err(err) => {
+                crate::note!("error: stdout: {err}");
+                1
+            }
         },
         ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand | ErrorKind::MissingSubcommand => {
             crate::note!(
