@@ -80,10 +80,10 @@ fn lights_and_environment(ui: &mut egui::Ui, s: &PanelState, actions: &mut Vec<A
                             Light::Spot { .. } => "spot",
                         }
                     ));
-                    if s.lights.len() > 1 || s.environment.is_some() {
-                        if ui.small_button("remove").clicked() {
-                            actions.push(Action::RemoveLight(k));
-                        }
+                    // The last light stays unless the environment lights the scene.
+                    let removable = s.lights.len() > 1 || s.environment.is_some();
+                    if removable && ui.small_button("remove").clicked() {
+                        actions.push(Action::RemoveLight(k));
                     }
                 });
                 match &mut edited {
