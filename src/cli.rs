@@ -148,21 +148,32 @@ pub struct BenchArgs {
     /// Epsilons of the sweep.
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true, default_values = ["0.4", "0.2", "0.1", "0.05", "0.025"])]
     pub epsilons: Vec<f32>,
-    #[arg(long, allow_hyphen_values = true, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=16384))]
-    pub width: u32,
-    #[arg(long, allow_hyphen_values = true, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=16384))]
-    pub height: u32,
+    /// Image width of the per-pass table [default: 512]; typed, it (or --height) also sizes the
+    /// pbrt-v2 comparison and the scene of several objects unless their own sizes are typed.
+    #[arg(long, allow_hyphen_values = true, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    pub width: Option<u32>,
+    /// Image height of the per-pass table [default: 512].
+    #[arg(long, allow_hyphen_values = true, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    pub height: Option<u32>,
     /// Frames per configuration (the first is a warm-up).
     #[arg(long, allow_hyphen_values = true, default_value_t = 3, value_parser = clap::value_parser!(u32).range(2..=1000))]
     pub frames: u32,
+    /// Light counts of the lights table (directional lights on a spiral); the sky row is sampled
+    /// in the largest of them, at most 64 directions.
+    #[arg(long, allow_hyphen_values = true, value_delimiter = ',', value_parser = clap::value_parser!(u32).range(1..=4096), default_values = ["1", "8", "64", "256"], conflicts_with = "no_lights")]
+    pub lights: Vec<u32>,
+    /// Leave out the lights table.
+    #[arg(long)]
+    pub no_lights: bool,
     /// Image size (square) of the comparison with pbrt-v2 on its own scene (it builds the UV
-    /// sphere itself); 0 skips it.
-    #[arg(long, allow_hyphen_values = true, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(0..=16384))]
-    pub peer_size: u32,
+    /// sphere itself); 0 skips it [default: 1024, or the larger of --width and --height when
+    /// either is typed].
+    #[arg(long, allow_hyphen_values = true, value_parser = clap::value_parser!(u32).range(0..=16384))]
+    pub peer_size: Option<u32>,
     /// Image size (square) of a scene of several objects (two translucent, an opaque floor); 0
-    /// skips it.
-    #[arg(long, allow_hyphen_values = true, default_value_t = 512, value_parser = clap::value_parser!(u32).range(0..=16384))]
-    pub scene_size: u32,
+    /// skips it [default: 512, or the larger of --width and --height when either is typed].
+    #[arg(long, allow_hyphen_values = true, value_parser = clap::value_parser!(u32).range(0..=16384))]
+    pub scene_size: Option<u32>,
     #[command(flatten)]
     pub device: DeviceArgs,
 }
@@ -546,9 +557,13 @@ pub(crate) fn rgb(s: &str) -> std::result::Result<Vec3, String> {
 pub fn usage_exit(e: clap::Error) -> i32 {
     use clap::error::ErrorKind;
     match e.kind() {
+        // Help that cannot be written is a failure named like every other write to stdout.
         ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => match e.print() {
             Ok(()) => 0,
-            Err(_) => 1,
+            Err(err) => {
+                crate::note!("error: stdout: {err}");
+                1
+            }
         },
         ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand | ErrorKind::MissingSubcommand => {
             crate::note!(

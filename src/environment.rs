@@ -136,6 +136,76 @@ impl Environment {
         Ok(())
     }
 
+    /// Several environments as one (pbrt-v4 scenes may give several `infinite` lights, e.g. a map
+    /// and a constant): constants add; otherwise the result is the largest map, in its own
+    /// resolution, layout and frame, with every other environment's radiance (scaled, through its
+    /// own frame) added per texel, sampled 4×4 within the texel so a finer map is averaged rather
+    /// than point-sampled. Scales are folded into the texels (the sum's scale is 1).
+    pub fn sum(parts: &[Environment]) -> Result<Environment> {
+        let [first, rest @ ..] = parts else {
+            return Err(crate::runtime!("Environment::sum: no environment"));
+        };
+        for p in parts {
+            p.validate()?;
+        }
+        if rest.is_empty() {
+            return Ok(first.clone());
+        }
+        let name = parts.iter().map(|p| p.name.as_str()).collect::<Vec<_>>().join(" + ");
+        let texels_of = |p: &Environment| match &p.radiance {
+            Radiance::Image { width, height, .. } => *width as u64 * *height as u64,
+            Radiance::Constant(_) => 0,
+        };
+        let (b, base) = parts.iter().enumerate().max_by_key(|(i, p)| (texels_of(p), std::cmp::Reverse(*i))).unwrap();
+        let Radiance::Image { width, height, layout, texels } = &base.radiance else {
+            let total: Vec3 = parts
+                .iter()
+                .map(|p| if let Radiance::Constant(l) = p.radiance { l * p.scale } else { Vec3::ZERO })
+                .sum();
+            return Ok(Environment {
+                name,
+                radiance: Radiance::Constant(total),
+                scale: 1.0,
+                to_world: Mat3::IDENTITY,
+                samples: first.samples,
+            });
+        };
+        let (w, h, layout) = (*width, *height, *layout);
+        const SUB: u32 = 4;
+        let mut sum: Vec<[f32; 3]> = Vec::with_capacity(texels.len());
+        for y in 0..h {
+            for x in 0..w {
+                let mut l = Vec3::from(texels[(y * w + x) as usize]) * base.scale;
+                let mut others = Vec3::ZERO;
+                for p in parts.iter().enumerate().filter(|&(i, _)| i != b).map(|(_, p)| p) {
+                    if let Radiance::Constant(c) = p.radiance {
+                        others += c * p.scale;
+                        continue;
+                    }
+                    let mut acc = Vec3::ZERO;
+                    for sy in 0..SUB {
+                        for sx in 0..SUB {
+                            let u = (x as f64 + (sx as f64 + 0.5) / SUB as f64) / w as f64;
+                            let v = (y as f64 + (sy as f64 + 0.5) / SUB as f64) / h as f64;
+                            let world = base.to_world * uv_to_direction(layout, u, v).as_vec3();
+                            acc += p.radiance_toward(world.normalize());
+                        }
+                    }
+                    others += acc / (SUB * SUB) as f32;
+                }
+                l += others;
+                sum.push(l.to_array());
+            }
+        }
+        Ok(Environment {
+            name,
+            radiance: Radiance::Image { width: w, height: h, layout, texels: Arc::new(sum) },
+            scale: 1.0,
+            to_world: base.to_world,
+            samples: first.samples,
+        })
+    }
+
     /// Radiance arriving from world direction `d` (unit), scaled: the texel it falls in.
     pub fn radiance_toward(&self, d: Vec3) -> Vec3 {
         let local = self.to_world.transpose() * d;

@@ -240,7 +240,21 @@ impl RenderSettings {
 
 /// `--env FILE | const:L` with its scale, rotation and sample count.
 fn environment_from_args(spec: &str, args: &RenderArgs) -> Result<crate::environment::Environment> {
-    use crate::environment::{rotation_about_up, Environment, Radiance};
+    use crate::environment::{rotation_about_up, Environment};
+    let env = Environment {
+        name: format!("--env {spec}"),
+        radiance: environment_radiance(spec)?,
+        scale: args.env_scale,
+        to_world: rotation_about_up(args.env_rotate),
+        samples: args.env_samples,
+    };
+    env.validate()?;
+    Ok(env)
+}
+
+/// The radiance `--env SPEC` names (FILE, const:L or sky[:E:A]); the viewer's `env` line too.
+pub fn environment_radiance(spec: &str) -> Result<crate::environment::Radiance> {
+    use crate::environment::{Environment, Radiance};
     let sky = |rest: &str| -> Result<Radiance> {
         let v: Vec<f32> = rest
             .split(':')
@@ -261,13 +275,5 @@ fn environment_from_args(spec: &str, args: &RenderArgs) -> Result<crate::environ
     } else {
         Environment::load(std::path::Path::new(spec), &format!("--env {spec}"))?
     };
-    let env = Environment {
-        name: format!("--env {spec}"),
-        radiance,
-        scale: args.env_scale,
-        to_world: rotation_about_up(args.env_rotate),
-        samples: args.env_samples,
-    };
-    env.validate()?;
-    Ok(env)
+    Ok(radiance)
 }

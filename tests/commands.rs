@@ -139,3 +139,47 @@ fn bad_material_values_exit_2_naming_the_value() {
         assert!(stderr(&out).contains(needle), "{args:?}: {}", stderr(&out));
     }
 }
+
+/// A bench asked to be small is small (issue #28): the lights table has only the counts asked for
+/// (the sky in as many directions as the most of them), and the size typed for the frame sizes the
+/// pbrt-v2 comparison and the scene of several objects too.
+#[test]
+fn a_small_bench_keeps_every_table_small() {
+    let started = std::time::Instant::now();
+    let args = [
+        "bench",
+        "--validation",
+        "--meshes",
+        "sphere",
+        "--samples",
+        "1024",
+        "--accuracy-size",
+        "16",
+        "--accuracy-samples",
+        "1024",
+        "--epsilons",
+        "0.2",
+        "--width",
+        "32",
+        "--height",
+        "32",
+        "--frames",
+        "2",
+        "--lights",
+        "1,8",
+    ];
+    let out = common::translucent(&args);
+    let wall = started.elapsed().as_secs_f64();
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert_eq!(out.status.code(), Some(0), "{}", common::stderr(&out));
+    let lights = text.split("### Lights").nth(1).expect("a lights table").split("###").next().unwrap();
+    let rows: Vec<&str> = lights.lines().filter(|l| l.starts_with("| ") && !l.starts_with("| lights")).collect();
+    assert_eq!(rows.len(), 3, "{lights}");
+    assert!(
+        rows[0].starts_with("| 1 |") && rows[1].starts_with("| 8 |") && rows[2].starts_with("| sky, 8 directions |"),
+        "{lights}"
+    );
+    assert!(text.contains("| 32² |"), "the pbrt-v2 comparison at the typed size:\n{text}");
+    assert!(text.contains("32x32: sphere in marble"), "the scene of objects at the typed size:\n{text}");
+    eprintln!("small bench: {wall:.1} s");
+}

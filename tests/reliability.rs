@@ -140,10 +140,14 @@ fn class2_full_or_closed_stdout_and_stderr_never_panic() {
         let out = bin().args(&args).stdout(Stdio::null()).stderr(full).output().unwrap();
         assert_eq!(out.status.code(), Some(code), "{args:?} 2>/dev/full");
     }
-    // --help to a full stdout is a failure too.
-    let full = std::fs::File::create("/dev/full").unwrap();
-    let out = bin().arg("--help").stdout(full).stderr(Stdio::null()).output().unwrap();
-    assert_eq!(out.status.code(), Some(1));
+    // --help and --version to a full stdout are failures too, named as every other command's.
+    for args in [vec!["--help"], vec!["--version"], vec!["render", "--help"], vec!["bench", "-h"], vec!["help", "view"]]
+    {
+        let full = std::fs::File::create("/dev/full").unwrap();
+        let out = bin().args(&args).stdout(full).stderr(Stdio::piped()).output().unwrap();
+        assert_runtime_failure(&out, "stdout", &format!("{args:?} > /dev/full"));
+        assert!(stderr(&out).contains("error: stdout: No space left on device"), "{args:?}: {}", stderr(&out));
+    }
 }
 
 // 3. Silently wrong output: a full disk.

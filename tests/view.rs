@@ -514,3 +514,51 @@ Shape "trianglemesh" "integer indices" [ 0 2 1 0 3 2 ] "point3 P" [ -4 0 -4 4 0 
     assert_eq!((a.width(), a.height()), (120, 90), "the window takes the film's size");
     assert!(a == b, "the viewer's screenshot differs from render's image");
 }
+
+/// The environment and the lights are edited from a script as the panel edits them (issue #28):
+/// a sky set, scaled, turned and sampled, a point light added and the first light moved give the
+/// image `render` gives with the same flags.
+#[test]
+fn environment_and_lights_edited_in_the_viewer_equal_render() {
+    if !have_xvfb() {
+        return;
+    }
+    let shot = png("env-lights");
+    let mut args = SCENE.to_vec();
+    args.extend_from_slice(&["--light", "dir:0,1,0"]);
+    let lines = [
+        "env sky:20:90".to_string(),
+        "env scale 0.5".into(),
+        "env rotate 30".into(),
+        "env samples 16".into(),
+        "light add point:1.5,1,1:4".into(),
+        "light 1 dir:-0.5,0.8,0.6".into(),
+        format!("screenshot {}", shot.display()),
+        "quit".into(),
+    ];
+    let lines: Vec<&str> = lines.iter().map(|s| s.as_str()).collect();
+    assert_ok("env-lights", &view("env-lights", &args, &lines));
+    let rendered = png("env-lights-render");
+    let mut render = vec!["render", "--validation"];
+    render.extend_from_slice(SCENE);
+    render.extend_from_slice(&[
+        "--light",
+        "dir:-0.5,0.8,0.6",
+        "--light",
+        "point:1.5,1,1:4",
+        "--env",
+        "sky:20:90",
+        "--env-scale",
+        "0.5",
+        "--env-rotate",
+        "30",
+        "--env-samples",
+        "16",
+        "--out",
+        rendered.to_str().unwrap(),
+    ]);
+    let out = translucent(&render);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let diff = output::compare(&load(&shot), &load(&rendered)).unwrap();
+    assert!(diff.rmse < 0.5 && diff.differing_fraction < 0.001, "{diff:?}");
+}

@@ -44,21 +44,30 @@ fn bench(args: &BenchArgs) -> Result<i32> {
         }
         m
     });
-    let options = crate::bench::BenchOptions {
+    let options = bench_options(args, meshes);
+    crate::error::write_stdout(&crate::bench::run(&options)?)?;
+    Ok(0)
+}
+
+/// The bench's options from its flags: a size typed for the frame (--width, --height) sizes
+/// every table that has no size of its own typed, so a bench asked to be small is small.
+pub fn bench_options(args: &BenchArgs, meshes: Vec<String>) -> crate::bench::BenchOptions {
+    let (width, height) = (args.width.unwrap_or(512), args.height.unwrap_or(512));
+    let typed = (args.width.is_some() || args.height.is_some()).then_some(width.max(height));
+    crate::bench::BenchOptions {
         meshes,
         samples: args.samples.clone(),
-        width: args.width,
-        height: args.height,
+        width,
+        height,
         frames: args.frames,
         accuracy_size: args.accuracy_size,
         accuracy_samples: args.accuracy_samples.clone(),
         epsilons: args.epsilons.clone(),
-        peer_size: args.peer_size,
-        scene_size: args.scene_size,
+        lights: if args.no_lights { Vec::new() } else { args.lights.clone() },
+        peer_size: args.peer_size.or(typed).unwrap_or(1024),
+        scene_size: args.scene_size.or(typed).unwrap_or(512),
         context: args.device.options(),
-    };
-    crate::error::write_stdout(&crate::bench::run(&options)?)?;
-    Ok(0)
+    }
 }
 
 fn check_output_path(path: &Path, flag: &str, allowed: &[&str]) -> Result<()> {
@@ -93,4 +102,28 @@ fn check_output_path(path: &Path, flag: &str, allowed: &[&str]) -> Result<()> {
 /// `--out` for frame `index`: `{frame}` replaced by the zero-padded number.
 fn frame_path(out: &Path, index: u32) -> PathBuf {
     PathBuf::from(out.to_string_lossy().replace("{frame}", &format!("{index:04}")))
+}
+
+#[cfg(test)]
+mod tests {
+    use clap::Parser;
+
+    fn options(argv: &[&str]) -> crate::bench::BenchOptions {
+        let cli = crate::cli::Cli::try_parse_from([&["translucent", "bench"], argv].concat()).unwrap();
+        let crate::cli::Command::Bench(args) = cli.command else { unreachable!() };
+        super::bench_options(&args, vec!["sphere".into()])
+    }
+
+    #[test]
+    fn a_small_bench_is_small_and_the_default_unchanged() {
+        let d = options(&[]);
+        assert_eq!((d.width, d.height, d.peer_size, d.scene_size), (512, 512, 1024, 512));
+        assert_eq!(d.lights, [1, 8, 64, 256]);
+        let s = options(&["--width", "32", "--height", "24", "--lights", "1,8"]);
+        assert_eq!((s.width, s.height, s.peer_size, s.scene_size), (32, 24, 32, 32));
+        assert_eq!(s.lights, [1, 8]);
+        assert!(options(&["--no-lights"]).lights.is_empty());
+        let own = options(&["--width", "32", "--peer-size", "0", "--scene-size", "64"]);
+        assert_eq!((own.peer_size, own.scene_size), (0, 64));
+    }
 }

@@ -284,9 +284,10 @@ pub fn flag_given(argv: &[String], flag: &str) -> bool {
 /// The smallest roughness the specular lobe is given for pbrt's smooth (roughness 0) surface.
 pub const MIN_ROUGHNESS: f32 = 0.05;
 
-/// The renderer's settings for a pbrt scene: today one translucent object (a shape with a
-/// `subsurface` material), distant and point lights (at most 8) and a perspective camera; any
-/// other object or light is refused, naming its file:line:column. Flags typed on the command line
+/// The renderer's settings for a pbrt scene: every `subsurface` shape a translucent object (at
+/// least one), every `diffuse` one an opaque object, the distant, point and spot lights, the
+/// `infinite` ones summed into one environment, and a perspective camera; anything else is
+/// refused, naming its file:line:column. Flags typed on the command line
 /// (`given`) override the scene: --width, --height, --out, --eye, --target, --up, --fov, the
 /// lights, the material flags, --scale, --roughness; the others (--model, --epsilon, --samples, …)
 /// apply as always. Returns the arguments with the film's size and file filled in, for the rest of
@@ -318,7 +319,8 @@ pub fn render_settings(
         return Err(bad_input!("{shown}: no shape with a subsurface material (nothing to render)"));
     };
     let mut lights = Vec::new();
-    let mut environment: Option<crate::environment::Environment> = None;
+    // Every `infinite` light, summed into one environment below (pbrt-v4 adds them).
+    let mut environments: Vec<crate::environment::Environment> = Vec::new();
     for l in &scene.lights {
         let rgb = |c: [f64; 3], s: f64| Vec3::new((c[0] * s) as f32, (c[1] * s) as f32, (c[2] * s) as f32);
         match l {
@@ -336,11 +338,6 @@ pub fn render_settings(
                     .map_err(|e| bad_input!("{loc}: LightSource \"spot\": {e}"))?,
             ),
             LightDesc::Infinite { filename, l, scale, frame, loc } => {
-                if environment.is_some() {
-                    return Err(bad_input!(
-                        "{loc}: LightSource \"infinite\": one environment light per scene is rendered"
-                    ));
-                }
                 let shown = format!("{loc}: LightSource \"infinite\"");
                 let radiance = match (filename, l) {
                     (Some(f), _) => crate::environment::Environment::load(f, &format!("{shown} \"{}\"", f.display()))?,
@@ -356,7 +353,7 @@ pub fn render_settings(
                 if !ortho {
                     return Err(bad_input!("{shown}: its transform must be a rotation"));
                 }
-                environment = Some(crate::environment::Environment {
+                environments.push(crate::environment::Environment {
                     name: shown,
                     radiance,
                     scale: *scale as f32,
@@ -366,6 +363,10 @@ pub fn render_settings(
             }
         }
     }
+    let mut environment = match environments.len() {
+        0 => None,
+        _ => Some(crate::environment::Environment::sum(&environments)?),
+    };
     let camera = scene.camera.clone().unwrap_or_else(|| CameraDesc {
         eye: DVec3::ZERO,
         target: DVec3::Z,

@@ -34,6 +34,14 @@ pub enum Action {
     },
     /// Replace the first light.
     SetLight(Light),
+    /// Replace light K (0-based, among the lights that are not the environment's samples).
+    SetLightAt(usize, Light),
+    /// Add a light (after the others, before the environment's samples).
+    AddLight(Light),
+    /// Remove light K (0-based, as for `SetLightAt`).
+    RemoveLight(usize),
+    /// Change the environment: its map, scale, rotation or sample count.
+    Environment(EnvEdit),
     /// A material preset by name.
     Material(String),
     Set(Setting),
@@ -60,6 +68,19 @@ pub enum Drag {
     Orbit,
     Pan,
     Light,
+}
+
+/// A change to the environment light (`--env` and its flags, or a pbrt scene's `infinite`).
+#[derive(Clone, Debug, PartialEq)]
+pub enum EnvEdit {
+    /// A new map, as `--env` names it (FILE, const:L, sky[:E:A]); `None` removes it.
+    Map(Option<String>),
+    /// `--env-scale`.
+    Scale(f32),
+    /// `--env-rotate`: degrees about the up axis, on top of the map's own frame.
+    Rotate(f32),
+    /// `--env-samples`.
+    Samples(u32),
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -109,6 +130,14 @@ pub fn parse_script(text: &str) -> std::result::Result<Vec<ScriptLine>, (usize, 
         lines.push(ScriptLine { number: i + 1, text: line.to_string(), action });
     }
     Ok(lines)
+}
+
+/// A light's number on a script line (1 is the first), as a 0-based index.
+fn light_number(s: &str) -> std::result::Result<usize, String> {
+    match s.parse::<usize>() {
+        Ok(k) if k >= 1 => Ok(k - 1),
+        _ => Err(format!("light '{s}': lights are numbered from 1")),
+    }
 }
 
 fn count(s: &str) -> std::result::Result<u32, String> {
@@ -166,11 +195,46 @@ pub fn parse_line(line: &str) -> std::result::Result<Action, String> {
         }
         "light" => match args {
             ["turn", r, u] => Action::TurnLights { right_deg: number(r)?, up_deg: number(u)? },
+            ["add", spec] => Action::AddLight(crate::cli::light_spec(spec)?),
+            ["remove", k] => Action::RemoveLight(light_number(k)?),
+            [k, spec] if k.parse::<u64>().is_ok() => Action::SetLightAt(light_number(k)?, crate::cli::light_spec(spec)?),
             [spec] => Action::SetLight(crate::cli::light_spec(spec)?),
             _ => {
-                return Err(format!("expected `light SPEC` ({}) or `light turn RIGHT_DEG UP_DEG`", crate::cli::LIGHT_FORMS))
+                return Err(format!(
+                    "expected `light SPEC` ({}), `light N SPEC`, `light add SPEC`, `light remove N` or `light turn RIGHT_DEG UP_DEG`",
+                    crate::cli::LIGHT_FORMS
+                ))
             }
         },
+        "env" => Action::Environment(match args {
+            ["off"] => EnvEdit::Map(None),
+            ["scale", v] => {
+                let v = number(v)?;
+                if v < 0.0 {
+                    return Err(format!("env scale {v}: must be ≥ 0"));
+                }
+                EnvEdit::Scale(v)
+            }
+            ["rotate", deg] => EnvEdit::Rotate(number(deg)?),
+            ["samples", k] => {
+                let k = count(k)?;
+                if !(1..=crate::environment::MAX_SAMPLES).contains(&k) {
+                    return Err(format!("env samples {k}: must be between 1 and {}", crate::environment::MAX_SAMPLES));
+                }
+                EnvEdit::Samples(k)
+            }
+            // Checked (the file read) when the script is loaded, so a bad map is bad input at once.
+            [spec] => {
+                crate::settings::environment_radiance(spec).map_err(|e| e.to_string())?;
+                EnvEdit::Map(Some(spec.to_string()))
+            }
+            _ => {
+                return Err(
+                    "expected `env FILE|const:L|sky[:E:A]`, `env off`, `env scale S`, `env rotate DEG` or `env samples K`"
+                        .into(),
+                )
+            }
+        }),
         "material" => {
             want(1, "material NAME")?;
             crate::materials::Material::find(args[0]).map_err(|e| e.to_string())?;
@@ -262,7 +326,7 @@ pub fn parse_line(line: &str) -> std::result::Result<Action, String> {
             Action::Quit
         }
         other => return Err(format!(
-            "unknown command '{other}' (orbit, pan, zoom, light, drag, material, set, frames, screenshot, resize, pause, trace, quit)"
+            "unknown command '{other}' (orbit, pan, zoom, light, env, drag, material, set, frames, screenshot, resize, pause, trace, quit)"
         )),
     };
     Ok(action)
@@ -378,6 +442,24 @@ mod tests {
         assert_eq!(lines[0].number, 2);
         assert_eq!(lines[0].action, Action::Orbit { right_deg: 30.0, up_deg: 0.0 });
         assert_eq!(lines[4].action, Action::Set(Setting::Epsilon(0.05)));
+        let edits = parse_script(
+            "light add point:1,2,3:4\nlight 2 dir:0,1,0\nlight remove 1\nenv sky:20:90\nenv scale 0.5\nenv rotate 30\nenv samples 16\nenv off\n",
+        )
+        .unwrap();
+        let actions: Vec<Action> = edits.into_iter().map(|l| l.action).collect();
+        assert_eq!(
+            actions,
+            vec![
+                Action::AddLight(Light::Point { position: Vec3::new(1.0, 2.0, 3.0), intensity: Vec3::splat(4.0) }),
+                Action::SetLightAt(1, Light::Directional { toward: Vec3::Y, irradiance: Vec3::ONE }),
+                Action::RemoveLight(0),
+                Action::Environment(EnvEdit::Map(Some("sky:20:90".into()))),
+                Action::Environment(EnvEdit::Scale(0.5)),
+                Action::Environment(EnvEdit::Rotate(30.0)),
+                Action::Environment(EnvEdit::Samples(16)),
+                Action::Environment(EnvEdit::Map(None)),
+            ]
+        );
         let spot = parse_script("light spot:0,2,0:0,0,0:30:5:2\n").unwrap();
         assert_eq!(
             spot[0].action,
@@ -395,6 +477,12 @@ mod tests {
             ("light spot:0,1,0:0,0,0:200", "cone angle 200°"),
             ("light spot:0,1,0", "spot:X,Y,Z:TX,TY,TZ:ANGLE"),
             ("light", "light SPEC"),
+            ("light 0 dir:0,1,0", "numbered from 1"),
+            ("light add spot:0,1,0", "spot:X,Y,Z:TX,TY,TZ:ANGLE"),
+            ("env", "env FILE"),
+            ("env scale -1", "≥ 0"),
+            ("env samples 0", "between 1 and 4096"),
+            ("env no-such-map.exr", "no-such-map.exr"),
         ] {
             let (n, _, why) = parse_script(&format!("quit\n{bad}\n")).unwrap_err();
             assert_eq!(n, 2, "{bad}");

@@ -288,6 +288,13 @@ fn panel_state(
         work_per_pixel: numbers.work_per_pixel,
         passes: numbers.passes.clone(),
         refining: numbers.refining,
+        lights: view.own_lights().to_vec(),
+        environment: d.environment.as_ref().map(|e| panel::EnvironmentState {
+            name: e.name.clone(),
+            scale: e.scale,
+            rotate_deg: view.env_rotate_deg,
+            samples: e.samples,
+        }),
     }
 }
 
@@ -403,7 +410,12 @@ impl Viewer {
             presenter,
             renderer,
             window,
-            view: ViewState::new(world, desc),
+            // From flags the environment's frame is --env-rotate's rotation (`env rotate` sets
+            // it again); a scene's is its light's transform.
+            view: match r.scene {
+                None => ViewState::new(world, desc).with_env_rotation(r.env_rotate),
+                Some(_) => ViewState::new(world, desc),
+            },
             schedule: Schedule::default(),
             size: (size.width, size.height),
             script,

@@ -3,9 +3,12 @@
 
 use egui::{Color32, RichText, SliderClamping::Edits};
 
-use super::controls::{Action, Setting};
+use glam::Vec3;
+
+use super::controls::{Action, EnvEdit, Setting};
 use crate::frame_desc::Show;
 use crate::physics::Model;
+use crate::scene::Light;
 
 /// What the panel shows: the current settings and the last frames' numbers.
 pub struct PanelState {
@@ -31,6 +34,146 @@ pub struct PanelState {
     pub passes: Vec<(String, f64)>,
     /// Refinement of the frame in progress, 0 to 1.
     pub refining: Option<f32>,
+    /// The user's lights (not the environment's samples), in order.
+    pub lights: Vec<Light>,
+    /// The environment light, when there is one.
+    pub environment: Option<EnvironmentState>,
+}
+
+/// The environment as the panel shows it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EnvironmentState {
+    pub name: String,
+    pub scale: f32,
+    /// Degrees about the up axis on top of the map's own frame.
+    pub rotate_deg: f32,
+    pub samples: u32,
+}
+
+/// Three drag values for a vector; `Some` when one was changed.
+fn vector(ui: &mut egui::Ui, label: &str, v: Vec3, speed: f64) -> Option<Vec3> {
+    let mut a = v.to_array();
+    ui.horizontal(|ui| {
+        ui.label(label);
+        for c in &mut a {
+            ui.add(egui::DragValue::new(c).speed(speed).max_decimals(3));
+        }
+    });
+    (Vec3::from(a) != v).then(|| Vec3::from(a))
+}
+
+/// The lights, each editable where it is (direction or position, strength), removable, and
+/// buttons that add one; then the environment: its map (as `--env` names it), scale, rotation
+/// about the up axis and sample count.
+fn lights_and_environment(ui: &mut egui::Ui, s: &PanelState, actions: &mut Vec<Action>) {
+    egui::CollapsingHeader::new("Lights").default_open(false).show(ui, |ui| {
+        for (k, light) in s.lights.iter().enumerate() {
+            ui.push_id(k, |ui| {
+                let mut edited = *light;
+                ui.horizontal(|ui| {
+                    ui.label(format!(
+                        "{} {}",
+                        k + 1,
+                        match light {
+                            Light::Directional { .. } => "directional",
+                            Light::Point { .. } => "point",
+                            Light::Spot { .. } => "spot",
+                        }
+                    ));
+                    // The last light stays unless the environment lights the scene.
+                    let removable = s.lights.len() > 1 || s.environment.is_some();
+                    if removable && ui.small_button("remove").clicked() {
+                        actions.push(Action::RemoveLight(k));
+                    }
+                });
+                match &mut edited {
+                    Light::Directional { toward, irradiance } => {
+                        if let Some(v) = vector(ui, "toward", *toward, 0.01) {
+                            *toward = v;
+                        }
+                        if let Some(v) = vector(ui, "E", *irradiance, 0.01) {
+                            *irradiance = v.max(Vec3::ZERO);
+                        }
+                    }
+                    Light::Point { position, intensity } | Light::Spot { position, intensity, .. } => {
+                        if let Some(v) = vector(ui, "at", *position, 0.02) {
+                            *position = v;
+                        }
+                        if let Some(v) = vector(ui, "I", *intensity, 0.05) {
+                            *intensity = v.max(Vec3::ZERO);
+                        }
+                    }
+                }
+                if let Light::Directional { toward, .. } = &mut edited {
+                    if *toward == Vec3::ZERO {
+                        edited = *light; // a direction of zero length: not taken
+                    }
+                }
+                if edited != *light {
+                    actions.push(Action::SetLightAt(k, edited));
+                }
+            });
+        }
+        ui.horizontal(|ui| {
+            if ui.button("add directional").clicked() {
+                actions.push(Action::AddLight(Light::Directional { toward: Vec3::Y, irradiance: Vec3::ONE }));
+            }
+            if ui.button("add point").clicked() {
+                actions.push(Action::AddLight(Light::Point {
+                    position: Vec3::new(0.0, 2.0, 2.0),
+                    intensity: Vec3::splat(4.0),
+                }));
+            }
+        });
+    });
+    egui::CollapsingHeader::new("Environment").default_open(false).show(ui, |ui| {
+        // The map being typed lives in egui's memory between frames.
+        let id = ui.id().with("env map");
+        let mut spec = ui.data_mut(|d| d.get_temp::<String>(id)).unwrap_or_default();
+        ui.horizontal(|ui| {
+            ui.add(egui::TextEdit::singleline(&mut spec).hint_text("FILE, const:L or sky:E:A").desired_width(150.0));
+            if ui.button("set").clicked() && !spec.trim().is_empty() {
+                actions.push(Action::Environment(EnvEdit::Map(Some(spec.trim().to_string()))));
+            }
+            if s.environment.is_some() && ui.button("off").clicked() {
+                actions.push(Action::Environment(EnvEdit::Map(None)));
+            }
+        });
+        ui.data_mut(|d| d.insert_temp(id, spec));
+        let Some(env) = &s.environment else {
+            ui.label("no environment");
+            return;
+        };
+        ui.label(&env.name);
+        let mut scale = env.scale;
+        ui.add(
+            egui::DragValue::new(&mut scale)
+                .speed(0.01)
+                .range(0.0..=1e6)
+                .clamp_existing_to_range(false)
+                .prefix("scale "),
+        );
+        if scale != env.scale {
+            actions.push(Action::Environment(EnvEdit::Scale(scale)));
+        }
+        let mut rotate = env.rotate_deg;
+        ui.add(egui::Slider::new(&mut rotate, -180.0..=180.0).clamping(Edits).text("rotation °"));
+        if rotate != env.rotate_deg {
+            actions.push(Action::Environment(EnvEdit::Rotate(rotate)));
+        }
+        let mut samples = env.samples;
+        let response = ui.add(
+            egui::DragValue::new(&mut samples)
+                .speed(4)
+                .range(1..=crate::environment::MAX_SAMPLES)
+                .clamp_existing_to_range(false)
+                .prefix("samples "),
+        );
+        // New samples, a new hierarchy's light layout: only once the drag ends.
+        if samples != env.samples && !response.dragged() {
+            actions.push(Action::Environment(EnvEdit::Samples(samples)));
+        }
+    });
 }
 
 /// Draws the panel; every change becomes an action in `actions`.
@@ -160,6 +303,7 @@ pub fn draw(ctx: &egui::Context, s: &PanelState, actions: &mut Vec<Action>) {
                 }
             }
         });
+        lights_and_environment(ui, s, actions);
         egui::CollapsingHeader::new("Timings").default_open(true).show(ui, |ui| {
             ui.label(&s.device);
             ui.label(format!("{} · {:.2} fps", s.last_frame, s.fps));
@@ -205,6 +349,11 @@ mod tests {
             work_per_pixel: Some((10.0, 2.0)),
             passes: vec![("shade".into(), 1.0)],
             refining: Some(0.5),
+            lights: vec![
+                Light::Directional { toward: Vec3::new(0.3, 0.8, 0.5), irradiance: Vec3::ONE },
+                Light::Point { position: Vec3::new(1.0, 2.0, 3.0), intensity: Vec3::splat(4.0) },
+            ],
+            environment: Some(EnvironmentState { name: "--env sky".into(), scale: 1.0, rotate_deg: 0.0, samples: 64 }),
         }
     }
 
@@ -246,6 +395,47 @@ mod tests {
         frame(vec![egui::Event::PointerMoved(at), button(true)]);
         let (_, actions) = frame(vec![button(false)]);
         assert_eq!(actions, vec![Action::Set(Setting::BruteForce(true))]);
+    }
+
+    /// Opening the lights and clicking "add point" adds a point light; opening the environment
+    /// and clicking "off" removes it.
+    #[test]
+    fn the_panel_adds_lights_and_turns_the_environment_off() {
+        let ctx = egui::Context::default();
+        let s = state(crate::materials::Material::find("skin1").unwrap());
+        let screen = Some(egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(800.0, 1400.0)));
+        // Time moves on 0.3 s a frame: a section's opening animation (1/12 s) ends at once and a
+        // press and release still make a click (within 0.8 s).
+        let clock = std::cell::Cell::new(0.0);
+        let frame = |events: Vec<egui::Event>| {
+            let mut actions = Vec::new();
+            clock.set(clock.get() + 0.3);
+            let input = egui::RawInput { screen_rect: screen, events, time: Some(clock.get()), ..Default::default() };
+            let output = ctx.run_ui(input, |ui| draw(ui.ctx(), &s, &mut actions));
+            (output, actions)
+        };
+        let click = |needle: &str| {
+            let (output, _) = frame(Vec::new());
+            let at = text_position(&output.shapes, needle).unwrap_or_else(|| panic!("{needle} is drawn"));
+            let button = |pressed| egui::Event::PointerButton {
+                pos: at,
+                button: egui::PointerButton::Primary,
+                pressed,
+                modifiers: Default::default(),
+            };
+            frame(vec![egui::Event::PointerMoved(at), button(true)]);
+            let (_, actions) = frame(vec![button(false)]);
+            frame(vec![egui::Event::PointerGone]);
+            actions
+        };
+        frame(Vec::new());
+        assert!(click("Lights").is_empty(), "opening a section changes nothing");
+        assert_eq!(
+            click("add point"),
+            vec![Action::AddLight(Light::Point { position: Vec3::new(0.0, 2.0, 2.0), intensity: Vec3::splat(4.0) })]
+        );
+        assert!(click("Environment").is_empty());
+        assert_eq!(click("off"), vec![Action::Environment(EnvEdit::Map(None))]);
     }
 
     #[test]

@@ -23,6 +23,13 @@ pub struct ViewState {
     pub exposure_stops: f32,
     /// Whether a mesh sequence or deformation plays.
     pub playing: bool,
+    /// How many of `desc.lights`, at their end, are the environment's samples (the lights before
+    /// them are the ones the user gave, which `light` lines and the panel edit).
+    pub env_lights: usize,
+    /// The environment's own frame (a pbrt scene's light transform; identity from flags) and the
+    /// rotation about the up axis on top of it (`--env-rotate`, `env rotate`).
+    pub env_frame: glam::Mat3,
+    pub env_rotate_deg: f32,
 }
 
 /// What [`ViewState::apply`] did with an action.
@@ -42,7 +49,77 @@ impl ViewState {
             Exposure::Stops(s) => s,
             Exposure::Auto => 0.0,
         };
-        ViewState { world, desc, centre: centre.unwrap_or(Vec3::ZERO), exposure_stops, playing: true }
+        // The builders append the environment's samples after the other lights.
+        let env_lights = desc.environment.as_ref().and_then(|e| e.lights().ok()).map_or(0, |l| l.len());
+        let env_frame = desc.environment.as_ref().map_or(glam::Mat3::IDENTITY, |e| e.to_world);
+        ViewState {
+            world,
+            desc,
+            centre: centre.unwrap_or(Vec3::ZERO),
+            exposure_stops,
+            playing: true,
+            env_lights,
+            env_frame,
+            env_rotate_deg: 0.0,
+        }
+    }
+
+    /// As [`ViewState::new`] for an environment given by flags: its frame is `--env-rotate`'s
+    /// rotation about the up axis, which `env rotate` then replaces.
+    pub fn with_env_rotation(mut self, deg: f32) -> ViewState {
+        if self.desc.environment.is_some() {
+            (self.env_frame, self.env_rotate_deg) = (glam::Mat3::IDENTITY, deg);
+        }
+        self
+    }
+
+    /// The lights the user gave (not the environment's samples).
+    pub fn own_lights(&self) -> &[crate::scene::Light] {
+        &self.desc.lights[..self.desc.lights.len() - self.env_lights]
+    }
+
+    /// The environment after `edit`, and its samples in place of the old ones.
+    fn edit_environment(&mut self, edit: controls::EnvEdit) -> Result<()> {
+        use crate::environment::{rotation_about_up, Environment, DEFAULT_SAMPLES};
+        use controls::EnvEdit;
+        let current = self.desc.environment.as_deref().cloned();
+        let env = match (edit, current) {
+            (EnvEdit::Map(None), _) => None,
+            (EnvEdit::Map(Some(spec)), current) => {
+                let (scale, samples) = current.map_or((1.0, DEFAULT_SAMPLES), |c| (c.scale, c.samples));
+                if self.desc.environment.is_none() {
+                    (self.env_frame, self.env_rotate_deg) = (glam::Mat3::IDENTITY, 0.0);
+                }
+                Some(Environment {
+                    name: format!("env {spec}"),
+                    radiance: crate::settings::environment_radiance(&spec)?,
+                    scale,
+                    to_world: rotation_about_up(self.env_rotate_deg) * self.env_frame,
+                    samples,
+                })
+            }
+            (_, None) => {
+                return Err(crate::bad_input!(
+                    "env: there is no environment to change (give one with `env FILE|const:L|sky`)"
+                ))
+            }
+            (EnvEdit::Scale(scale), Some(c)) => Some(Environment { scale, ..c }),
+            (EnvEdit::Samples(samples), Some(c)) => Some(Environment { samples, ..c }),
+            (EnvEdit::Rotate(deg), Some(c)) => {
+                self.env_rotate_deg = deg;
+                Some(Environment { to_world: rotation_about_up(deg) * self.env_frame, ..c })
+            }
+        };
+        let samples = match &env {
+            Some(e) => e.lights()?,
+            None => Vec::new(),
+        };
+        let own = self.own_lights().len();
+        self.desc.lights.truncate(own);
+        self.env_lights = samples.len();
+        self.desc.lights.extend(samples);
+        self.desc.environment = env.map(std::sync::Arc::new);
+        Ok(())
     }
 
     /// The material of the (first) object.
@@ -54,7 +131,23 @@ impl ViewState {
     /// the checks refuse (g ≥ 1 typed on the panel, σ beyond f32) leaves everything as it was.
     pub fn apply(&mut self, action: Action) -> Result<Applied> {
         let (desc_before, material_before) = (self.desc.clone(), self.material().clone());
-        let before_stops = self.exposure_stops;
+        let before = (self.exposure_stops, self.env_lights, self.env_frame, self.env_rotate_deg);
+        let own = self.own_lights().len();
+        let light_index = |k: usize| {
+            if k < own {
+                Ok(k)
+            } else {
+                Err(crate::bad_input!("light {}: there are {own} light(s) besides the environment's samples", k + 1))
+            }
+        };
+        if let Action::Environment(edit) = action {
+            if let Err(e) = self.edit_environment(edit) {
+                (self.desc, self.env_lights, self.env_frame, self.env_rotate_deg) =
+                    (desc_before, before.1, before.2, before.3);
+                return Err(e);
+            }
+            return self.checked(desc_before, material_before, before);
+        }
         let d = &mut self.desc;
         match action {
             Action::Orbit { right_deg, up_deg } => controls::orbit(&mut d.camera, right_deg, up_deg),
@@ -63,7 +156,14 @@ impl ViewState {
             Action::TurnLights { right_deg, up_deg } => {
                 controls::turn_lights(&mut d.lights, &d.camera, self.centre, right_deg, up_deg)
             }
+            // The first of the user's lights; with none (an environment alone), a first one.
+            Action::SetLight(light) if own == 0 => d.lights.insert(0, light),
             Action::SetLight(light) => d.lights[0] = light,
+            Action::SetLightAt(k, light) => d.lights[light_index(k)?] = light,
+            Action::AddLight(light) => d.lights.insert(own, light),
+            Action::RemoveLight(k) => {
+                d.lights.remove(light_index(k)?);
+            }
             Action::Material(name) => self.world.objects[0].material = Material::find(&name)?,
             Action::TogglePause => self.playing = !self.playing,
             Action::Set(setting) => {
@@ -88,10 +188,20 @@ impl ViewState {
             }
             window => return Ok(Applied::Window(window)),
         }
+        self.checked(desc_before, material_before, before)
+    }
+
+    /// Keeps an edit that passes the checks, or puts everything back as it was.
+    fn checked(
+        &mut self,
+        desc_before: FrameDesc,
+        material_before: Material,
+        before: (f32, usize, glam::Mat3, f32),
+    ) -> Result<Applied> {
         let checked = crate::world::check_material(self.material()).and_then(|_| self.desc.validate());
         if let Err(e) = checked {
             (self.desc, self.world.objects[0].material) = (desc_before, material_before);
-            self.exposure_stops = before_stops;
+            (self.exposure_stops, self.env_lights, self.env_frame, self.env_rotate_deg) = before;
             return Err(e);
         }
         Ok(Applied::Edited)
@@ -126,6 +236,47 @@ mod tests {
         assert_eq!(s.world.objects[0].samples, Some(5000));
         assert_eq!(s.material().name, Material::find("skin1").unwrap().name);
         assert_eq!(s.apply(Action::Quit).unwrap(), Applied::Window(Action::Quit));
+    }
+
+    /// Lights are added, moved and removed before the environment's samples; the environment's
+    /// map, scale, rotation and sample count replace its samples, and a refused edit changes
+    /// nothing.
+    #[test]
+    fn lights_and_the_environment_are_edited() {
+        use crate::environment::rotation_about_up;
+        use controls::EnvEdit;
+        let mut s = state();
+        let point = Light::Point { position: Vec3::new(1.0, 2.0, 3.0), intensity: Vec3::ONE };
+        s.apply(Action::Environment(EnvEdit::Map(Some("sky:20:90".into())))).unwrap();
+        s.apply(Action::Environment(EnvEdit::Samples(16))).unwrap();
+        assert_eq!((s.own_lights().len(), s.env_lights, s.desc.lights.len()), (1, 16, 17));
+        s.apply(Action::AddLight(point)).unwrap();
+        assert_eq!(s.own_lights()[1], point);
+        let moved = Light::Point { position: Vec3::new(-1.0, 0.0, 0.0), intensity: Vec3::ONE };
+        s.apply(Action::SetLightAt(1, moved)).unwrap();
+        assert_eq!(s.own_lights()[1], moved);
+        assert!(s.apply(Action::SetLightAt(2, moved)).is_err(), "only two lights of the user's");
+        // The samples as `--env sky:20:90 --env-scale 0.5 --env-rotate 30 --env-samples 16` gives them.
+        s.apply(Action::Environment(EnvEdit::Scale(0.5))).unwrap();
+        s.apply(Action::Environment(EnvEdit::Rotate(30.0))).unwrap();
+        let env = crate::environment::Environment {
+            name: "sky".into(),
+            radiance: crate::environment::sky(20.0, 90.0),
+            scale: 0.5,
+            to_world: rotation_about_up(30.0),
+            samples: 16,
+        };
+        assert_eq!(s.desc.lights[2..], env.lights().unwrap()[..]);
+        assert_eq!(s.desc.environment.as_ref().unwrap().to_world, rotation_about_up(30.0));
+        s.apply(Action::RemoveLight(0)).unwrap();
+        assert_eq!(s.own_lights(), &[moved]);
+        assert!(s.apply(Action::Environment(EnvEdit::Map(Some("/no/such/map.exr".into())))).is_err());
+        assert_eq!(s.env_lights, 16, "a refused map leaves the environment as it was");
+        s.apply(Action::Environment(EnvEdit::Map(None))).unwrap();
+        assert_eq!((s.desc.lights.len(), s.env_lights, s.desc.environment.is_none()), (1, 0, true));
+        assert!(s.apply(Action::RemoveLight(0)).is_err(), "the last light stays");
+        assert!(s.apply(Action::Environment(EnvEdit::Scale(2.0))).is_err(), "no environment to scale");
+        assert_eq!(s.own_lights(), &[moved]);
     }
 
     /// `set sigma-s 1e7` once skipped the f32 check that only `render` made; a refused edit
