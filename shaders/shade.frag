@@ -28,6 +28,9 @@ layout(constant_id = 0) const uint MODEL = 0u; // 0 directional dipole, 1 classi
 // Whether the near field is split off (see near_field()), fixed per pipeline for the same reason:
 // a frame without it pays nothing for its code.
 layout(constant_id = 1) const bool NEAR_FIELD = false;
+// One light: no point's lights spread, so point_evaluated() needs no sigma directions (llvmpipe
+// would run their four evaluations for every point, masked off or not).
+layout(constant_id = 2) const bool ONE_LIGHT = false;
 
 layout(location = 0) out vec4 radiance;
 
@@ -341,7 +344,7 @@ vec3 point_evaluated(uint index, vec3 xi, vec3 ni, vec3 power, vec4 incident[3],
                                                object_params.channels[2].sigma_tr);
     bool near = length(xo - xi) * object_params.mm_per_unit < reach;
     // The table models' Sd is radial: the sigma directions would sum to the one evaluation.
-    if (MODEL != MODEL_DIRECTIONAL || (a0 == vec3(0.0) && a1 == vec3(0.0)) || !near) {
+    if (MODEL != MODEL_DIRECTIONAL || ONE_LIGHT || (a0 == vec3(0.0) && a1 == vec3(0.0)) || !near) {
         made = 1u;
         return merged_source(xi, ni, power, incident, vec3(0.0), xo, no, true);
     }
@@ -600,7 +603,9 @@ void main() {
         uint tiles_across = (uint(imageSize(surface_position).x) + TILE_SIZE - 1u) / TILE_SIZE;
         uvec4 tile = texel(tile_headers, (uint(pixel.y) / TILE_SIZE) * tiles_across + uint(pixel.x) / TILE_SIZE);
         uint entry = tile.x;
-        for (uint e = 0u; e < tile.y; ++e) {
+        uint point_count = tile.y & 0xffffu, near_count = tile.y >> 16;
+        // The points within the near field's reach of the tile, with its control variate.
+        for (uint e = 0u; e < near_count; ++e) {
             uint index = tile_entry(entry + e);
             vec3 xi, power;
             vec4 incident[3];
@@ -616,8 +621,21 @@ void main() {
             near_sources += v * f;
             evaluations += made;
         }
-        evaluated += tile.y;
-        entry += tile.y;
+        // The rest, beyond its reach: no pixel of the tile pays for the variate's code there.
+        for (uint e = near_count; e < point_count; ++e) {
+            uint index = tile_entry(entry + e);
+            vec3 xi, power;
+            vec4 incident[3];
+            float area;
+            point_source(index, xi, power, incident, area);
+            if (power == vec3(0.0)) continue;
+            vec3 ni = texel_float(points, index * POINT_TEXELS + 1u).xyz;
+            uint made;
+            sum += point_evaluated(index, xi, ni, power, incident, xo, no, made);
+            evaluations += made;
+        }
+        evaluated += point_count;
+        entry += point_count;
         // Both sigma points of a node in one iteration: its records are loaded once.
         for (uint e = 0u; e < tile.z; ++e) {
             uint index = tile_entry(entry + e);
@@ -626,14 +644,13 @@ void main() {
             vec4 incident[3];
             float area;
             node_sigma(index, ni, xo, center, offset, power, incident, area);
-            float v_plus = near_correction(center + offset, ni, area, xo, no, evaluations);
-            float v_minus = near_correction(center - offset, ni, area, xo, no, evaluations);
+            // Never within the near field's reach of the tile: the tile cut opens such nodes, so
+            // no node pays for the control variate's unfolding (llvmpipe would run it for every
+            // node, reach or not).
             if (power == vec3(0.0)) continue;
             evaluations += 2u;
-            vec3 f_plus = merged_source(center + offset, ni, power, incident, vec3(0.0), xo, no, true);
-            vec3 f_minus = merged_source(center - offset, ni, power, incident, vec3(0.0), xo, no, true);
-            sum += f_plus + f_minus;
-            near_sources += v_plus * f_plus + v_minus * f_minus;
+            sum += merged_source(center + offset, ni, power, incident, vec3(0.0), xo, no, true)
+                 + merged_source(center - offset, ni, power, incident, vec3(0.0), xo, no, true);
         }
         visits += tile.z;
         entry += tile.z;
@@ -683,7 +700,10 @@ void main() {
                         // Unlit: only the near field's control variate needs it, within its reach.
                         if (power_area.xyz == vec3(0.0) && !(NEAR_FIELD && within_near_reach(xo, lo, hi))) continue;
                         vec3 d = uintBitsToFloat(center_left.xyz) - xo;
-                        bool inside = all(greaterThanEqual(xo, lo)) && all(lessThanEqual(xo, hi));
+                        // A node within the near field's reach is opened down to its points (only
+                        // points enter the control variate).
+                        bool inside = all(greaterThanEqual(xo, lo)) && all(lessThanEqual(xo, hi))
+                            || (NEAR_FIELD && within_near_reach(xo, lo, hi));
                         // A full stack or a spent step budget (see above) ends the descent: the
                         // node is then used whole, an approximation rather than a silently
                         // truncated sum.
@@ -709,19 +729,21 @@ void main() {
                     node_sigma(index, ni, xo, xi, offset, power, incident, area);
                     xi += evaluation != 0u ? -offset : offset;
                 }
-                float v = near_correction(xi, ni, area, xo, no, evaluations);
-                if (power == vec3(0.0)) continue;
-                vec3 f;
                 if (is_point) {
+                    float v = near_correction(xi, ni, area, xo, no, evaluations);
+                    if (power == vec3(0.0)) continue;
                     uint made;
-                    f = point_evaluated(index, xi, ni, power, incident, xo, no, made);
+                    vec3 f = point_evaluated(index, xi, ni, power, incident, xo, no, made);
                     evaluations += made;
+                    sum += f;
+                    near_sources += v * f;
                 } else {
+                    // Beyond the near field's reach (opened above when within it; a spent
+                    // budget may stop that, and the node is then used whole without its share).
+                    if (power == vec3(0.0)) continue;
                     ++evaluations;
-                    f = merged_source(xi, ni, power, incident, vec3(0.0), xo, no, true);
+                    sum += merged_source(xi, ni, power, incident, vec3(0.0), xo, no, true);
                 }
-                sum += f;
-                near_sources += v * f;
             }
         }
     }

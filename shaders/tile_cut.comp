@@ -60,10 +60,11 @@ uint next_after(uint last) {
 }
 
 // Counts (write = false) or writes (write = true, at `first`) the tile's list; returns the counts
-// of points, nodes and frontier entries.
-uvec3 walk(vec3 tile_lo, vec3 tile_hi, bool write, uint first, uvec3 counts) {
+// of points, nodes and frontier entries, and of the points within the near field's reach of the
+// tile, which are written first (only they need the control variate, shade.frag).
+uvec4 walk(vec3 tile_lo, vec3 tile_hi, bool write, uint first, uvec4 counts) {
     float tile_extent2 = dot(tile_hi - tile_lo, tile_hi - tile_lo);
-    uvec3 n = uvec3(0u);
+    uvec4 n = uvec4(0u);
     // The near field's reach, in scene units squared (0: no near field this frame).
     bool near = frame_params.near_field != 0u;
     float near_end = object_params.near_end_mm / object_params.mm_per_unit;
@@ -74,10 +75,12 @@ uvec3 walk(vec3 tile_lo, vec3 tile_hi, bool write, uint first, uvec3 counts) {
         ++steps;
         uint index = item & ~LEAF_BIT;
         if ((item & LEAF_BIT) != 0u) {
-            if (texel_float(points, index * POINT_TEXELS + 2u).xyz != vec3(0.0)
-                || (near && distance2_to_box(texel_float(points, index * POINT_TEXELS).xyz, tile_lo, tile_hi) < near_end2)) {
-                if (write) entries[first + n.x] = index;
+            bool reachable = near && distance2_to_box(texel_float(points, index * POINT_TEXELS).xyz, tile_lo, tile_hi) < near_end2;
+            if (texel_float(points, index * POINT_TEXELS + 2u).xyz != vec3(0.0) || reachable) {
+                // Within reach: at [0, counts.w); beyond it: after them.
+                if (write) entries[first + (reachable ? n.w : counts.w + n.x - n.w)] = index;
                 ++n.x;
+                if (reachable) ++n.w;
             }
             item = next_after(index);
             continue;
@@ -97,7 +100,10 @@ uvec3 walk(vec3 tile_lo, vec3 tile_hi, bool write, uint first, uvec3 counts) {
         }
         bool overlaps = all(lessThanEqual(lo, tile_hi)) && all(lessThanEqual(tile_lo, hi));
         float d2 = distance2_to_box(uintBitsToFloat(center_left.xyz), tile_lo, tile_hi);
-        bool whole = !overlaps && power_area.w < frame_params.epsilon * d2;
+        // A node within the near field's reach of the tile is opened down to its points: only
+        // points enter the control variate (shade.frag, near_correction()).
+        bool within_reach = near && box_distance2(lo, hi, tile_lo, tile_hi) < near_end2;
+        bool whole = !overlaps && !within_reach && power_area.w < frame_params.epsilon * d2;
         // Budgets: the list's evaluations against llvmpipe's loop budget (the shade pass loops
         // over them), and this walk's steps; past them a node is used whole, as the pixel walk
         // does.
@@ -141,13 +147,19 @@ void main() {
         headers[tile] = uvec4(0u);
         return;
     }
-    uvec3 counts = walk(lo, hi, false, 0u, uvec3(0u));
+    uvec4 counts = walk(lo, hi, false, 0u, uvec4(0u));
     uint total = counts.x + counts.y + counts.z;
+    // The header packs the point count with the near points' (16 bits each): the lists'
+    // evaluation budget keeps both far below 2^16.
+    if (counts.x >= 65536u) {
+        headers[tile] = uvec4(0u, 0u, 0u, WALK_FROM_ROOT);
+        return;
+    }
     uint first = atomicAdd(allocation.allocated, total);
     if (first + total > pc.capacity || first + total < first) {
         headers[tile] = uvec4(0u, 0u, 0u, WALK_FROM_ROOT);
         return;
     }
     walk(lo, hi, true, first, counts);
-    headers[tile] = uvec4(first, counts);
+    headers[tile] = uvec4(first, counts.x | (counts.w << 16), counts.y, counts.z);
 }

@@ -534,7 +534,7 @@ impl Renderer {
             ShadeConstants { view_projection, eye: desc.camera.eye.extend(1.0), point_range: glam::UVec4::ZERO };
         let shading = desc.show == Show::Shading;
         if shading {
-            self.passes.shade.prepare(&self.ctx, shade_variant(&integration), integration.brute_force)?;
+            self.passes.shade.prepare(&self.ctx, shade_variant(&desc), integration.brute_force)?;
         }
         let cut = shading && !integration.brute_force;
         let objects = self.world.objects.len();
@@ -643,7 +643,7 @@ impl Renderer {
     pub fn shade_some(&mut self, frame: &mut FrameInProgress, budget: Option<std::time::Duration>) -> Result<bool> {
         self.check_current(frame)?;
         let inputs: Vec<ShadeInputs> = (0..self.world.objects.len()).map(|k| shade_inputs!(self, k)).collect();
-        let (constants, variant) = (frame.constants, shade_variant(&frame.desc.integration));
+        let (constants, variant) = (frame.constants, shade_variant(&frame.desc));
         let started = std::time::Instant::now();
         // Shading in several submissions, so that none runs long (see src/batching.rs).
         let units = &frame.units;
@@ -782,7 +782,12 @@ impl Targets {
     }
 }
 
-/// The shade pass's pipeline for a frame integrated as `integration`.
-fn shade_variant(integration: &crate::frame_desc::Integration) -> crate::passes::shade::ShadeVariant {
-    crate::passes::shade::ShadeVariant { model: integration.model, near_field: integration.splits_near_field() }
+/// The shade pass's pipeline for a frame described by `desc`.
+fn shade_variant(desc: &FrameDesc) -> crate::passes::shade::ShadeVariant {
+    let integration = &desc.integration;
+    crate::passes::shade::ShadeVariant {
+        model: integration.model,
+        near_field: integration.splits_near_field(),
+        one_light: desc.lights.len() == 1,
+    }
 }

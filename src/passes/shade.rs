@@ -153,12 +153,15 @@ pub struct ShadeVariant {
     pub model: Model,
     /// The near field split off (`--near-field`).
     pub near_field: bool,
+    /// One light (an environment's samples count as lights): a point's lights cannot spread,
+    /// so its sigma directions (PointSpread) are compiled out.
+    pub one_light: bool,
 }
 
 impl ShadeVariant {
     /// The specialisation constants, in constant_id order.
-    fn specialization(&self) -> [u32; 2] {
-        [self.model.gpu_code(), self.near_field as u32]
+    fn specialization(&self) -> [u32; 3] {
+        [self.model.gpu_code(), self.near_field as u32, self.one_light as u32]
     }
 }
 
