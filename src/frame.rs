@@ -576,7 +576,16 @@ impl Renderer {
             }
             // The depth pre-pass and the G-buffer (world position with the object, normal, and
             // the reflectance of opaque objects).
-            rec.scope("surface", |rec| self.passes.shade.record_surface(rec, &inputs, &opaque, &constants))?;
+            let t = &self.targets;
+            let targets = shade::SurfaceTargets {
+                color: &t.color,
+                depth: &t.depth,
+                position: &t.position,
+                normal: &t.normal,
+                albedo: &t.albedo,
+                work: &self.work_counters,
+            };
+            rec.scope("surface", |rec| self.passes.shade.record_surface(rec, &targets, &inputs, &opaque, &constants))?;
             // What no surface covers: the environment, or black.
             let aspect = desc.width as f32 / desc.height as f32;
             let t = &self.targets;
@@ -701,6 +710,9 @@ impl Renderer {
             let mut lines = Vec::new();
             for o in &self.world.objects {
                 lines.extend(debug_view::tree_level_lines(&o.hierarchy.download(&self.ctx)?.nodes, level));
+            }
+            if self.world.objects.is_empty() {
+                return Err(crate::bad_input!("--show tree: the scene has no translucent object (no tree)"));
             }
             if lines.is_empty() {
                 return Err(crate::bad_input!("--level {level}: the tree has no internal nodes that deep"));

@@ -207,7 +207,7 @@ impl Opaque {
 /// Everything drawn, in one scale.
 #[derive(Clone, Debug, PartialEq)]
 pub struct World {
-    /// The translucent objects (at least one).
+    /// The translucent objects (none in a world of opaque objects only).
     pub objects: Vec<Object>,
     /// Opaque objects: they reflect the lights and cast shadows.
     pub opaque: Vec<Opaque>,
@@ -224,8 +224,8 @@ impl World {
     /// Every check of the world, with the flag each comes from named: the scale, each mesh (and
     /// its size in millimetres), each material, and the coefficients the GPU can hold in f32.
     pub fn validate(&self) -> Result<()> {
-        if self.objects.is_empty() {
-            return Err(bad_input!("the world has no translucent object"));
+        if self.objects.is_empty() && self.opaque.is_empty() {
+            return Err(bad_input!("the world has no object, translucent or opaque"));
         }
         for o in &self.opaque {
             o.validate()?;

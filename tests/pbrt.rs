@@ -414,3 +414,49 @@ fn two_infinite_lights_are_summed_each_in_its_own_frame() {
         assert_eq!(out.status.code(), Some(0), "{name}: {}", common::stderr(&out));
     }
 }
+
+/// A scene of `diffuse` shapes only (issue #28): rendered under validation with a warning that
+/// nothing in it is translucent, the opaque sphere covering the middle of the image and lit on the
+/// side its light comes from (pbrt's +x, the image's right); `--profile` and the work counters cope
+/// with no translucent object, `--show tree` and `--deform` say there is none, and a scene of no
+/// shape at all is still refused.
+#[test]
+fn a_scene_of_diffuse_shapes_only_renders_them_lit_with_a_warning() {
+    let d = dir("diffuse-only");
+    let scene = |shapes: &str| {
+        format!(
+            "LookAt 0 0 -6  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 30\nFilm \"rgb\" \"integer xresolution\" 48 \"integer yresolution\" 32 \"string filename\" \"{}\"\n\
+             WorldBegin\nLightSource \"distant\" \"point3 from\" [1 0 0] \"point3 to\" [0 0 0] \"rgb L\" [3 3 3]\n{shapes}",
+            d.join("diffuse.exr").display()
+        )
+    };
+    let sphere = "Material \"diffuse\" \"rgb reflectance\" [0.8 0.4 0.2]\nShape \"sphere\" \"float radius\" 0.6\n";
+    let path = write(&d, "diffuse.pbrt", &scene(sphere));
+    let out = render(&[path.to_str().unwrap(), "--validation", "--profile"]);
+    let err = common::stderr(&out);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(err.contains("warning: ") && err.contains("nothing in the scene is translucent"), "{err}");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("diffuse") && stdout.contains("surface"), "the profile's passes: {stdout}");
+    let img = image::open(d.join("diffuse.exr")).unwrap().into_rgba32f();
+    let (w, h) = img.dimensions();
+    assert!(img.get_pixel(w / 2, h / 2)[3] > 0.0 && img.get_pixel(0, 0)[3] == 0.0, "the sphere covers the middle");
+    let lum = |x: u32, y: u32| img.get_pixel(x, y).0[..3].iter().sum::<f32>();
+    // 4 pixels either side of the centre are on the sphere (its radius is 6 pixels).
+    let (l, r) = (w / 2 - 4, w / 2 + 4);
+    let (left, right) = (lum(l, h / 2), lum(r, h / 2));
+    assert!(right > 0.1 && right > 10.0 * left, "lit from the right: left {left}, right {right}");
+    assert!(img.get_pixel(r, h / 2)[0] > 2.0 * img.get_pixel(r, h / 2)[2], "its reflectance: orange");
+    // What needs a translucent object says there is none.
+    let out = render(&[path.to_str().unwrap(), "--show", "tree"]);
+    assert_eq!(out.status.code(), Some(2), "{}", common::stderr(&out));
+    assert!(common::stderr(&out).contains("no translucent object"), "{}", common::stderr(&out));
+    let out = render(&[path.to_str().unwrap(), "--deform", "twist:30"]);
+    assert_eq!(out.status.code(), Some(2), "{}", common::stderr(&out));
+    assert!(common::stderr(&out).contains("no translucent object"), "{}", common::stderr(&out));
+    // Nothing to draw at all.
+    let empty = write(&d, "empty.pbrt", &scene(""));
+    let out = render(&[empty.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2), "{}", common::stderr(&out));
+    assert!(common::stderr(&out).contains("no shape with a subsurface or diffuse material"));
+}

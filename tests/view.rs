@@ -562,3 +562,52 @@ fn environment_and_lights_edited_in_the_viewer_equal_render() {
     let diff = output::compare(&load(&shot), &load(&rendered)).unwrap();
     assert!(diff.rmse < 0.5 && diff.differing_fraction < 0.001, "{diff:?}");
 }
+
+/// A scene of `diffuse` shapes only (issue #28) in the viewer: the warning that nothing is
+/// translucent, its screenshot equals its render, and a script's material edit is refused naming
+/// the line (exit 2).
+#[test]
+fn a_scene_of_diffuse_shapes_only_in_the_viewer_equals_its_render() {
+    if !have_xvfb() {
+        return;
+    }
+    let dir = output_dir().join("view-diffuse-only");
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = r#"LookAt 0 2.5 5  0 0.4 0  0 1 0
+Camera "perspective" "float fov" [ 40 ]
+Film "rgb" "integer xresolution" [ 80 ] "integer yresolution" [ 60 ]
+WorldBegin
+LightSource "distant" "point3 from" [ 0.3 1 0.2 ] "point3 to" [ 0 0 0 ] "rgb L" [ 2 2 2 ]
+Material "diffuse" "rgb reflectance" [ 0.7 0.5 0.3 ]
+AttributeBegin
+  Translate 0 0.8 0
+  Shape "sphere" "float radius" 0.8
+AttributeEnd
+Shape "trianglemesh" "integer indices" [ 0 2 1 0 3 2 ] "point3 P" [ -4 0 -4 4 0 -4 4 0 4 -4 0 4 ]
+"#;
+    let path = dir.join("diffuse.pbrt");
+    std::fs::write(&path, scene).unwrap();
+    let (shot, rendered) = (png("diffuse-only"), png("diffuse-only-render"));
+    let line = format!("screenshot {}", shot.display());
+    let args = [path.to_str().unwrap(), "--exposure", "0"];
+    let out = view("diffuse-only", &args, &["frames 1", &line, "quit"]);
+    assert_ok("diffuse-only", &out);
+    assert!(stderr(&out).contains("nothing in the scene is translucent"), "{}", stderr(&out));
+    let out = translucent(&[
+        "render",
+        "--validation",
+        path.to_str().unwrap(),
+        "--exposure",
+        "0",
+        "--out",
+        rendered.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let (a, b) = (load(&shot), load(&rendered));
+    assert!(a == b, "the viewer's screenshot differs from render's image");
+    assert!(mean_colour(&a)[0] > 20.0, "lit: {:?}", mean_colour(&a));
+    let out = view("diffuse-only-material", &args, &["material marble", "quit"]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("line 1") && err.contains("no translucent object"), "{err}");
+}

@@ -43,7 +43,14 @@ fn render_settings(args: &RenderArgs, settings: RenderSettings) -> Result<i32> {
 
     let every_frame = args.out.to_string_lossy().contains("{frame}");
     let mesh_spec = SceneSettings::from_args(args).mesh_spec();
-    let first_mesh = world.objects[0].mesh.clone();
+    // The first translucent object is the one animated (a world of opaque objects only has none).
+    let first_mesh = match world.objects.first() {
+        Some(o) => o.mesh.clone(),
+        None if args.deform.is_some() => {
+            return Err(crate::bad_input!("--deform: the scene has no translucent object"))
+        }
+        None => world.opaque[0].mesh.clone(),
+    };
     let animation = crate::deform::Animation::new(&mesh_spec, &first_mesh, args.deform, args.deform_period, args.up)?;
     let base_lights = desc.lights.clone();
     let (centre, _) = crate::scene::bounding_sphere(&first_mesh.positions);

@@ -93,6 +93,17 @@ pub fn shade_units(width: u32, height: u32, tile: u32, brute_force_points: Optio
     units
 }
 
+/// What the surface pass writes: the frame's colour (cleared), depth and G-buffer, and the work
+/// counters (cleared).
+pub struct SurfaceTargets<'a> {
+    pub color: &'a Image,
+    pub depth: &'a Image,
+    pub position: &'a Image,
+    pub normal: &'a Image,
+    pub albedo: &'a Image,
+    pub work: &'a Buffer,
+}
+
 /// An opaque object's draw into the G-buffer.
 pub struct OpaqueDraw<'a> {
     pub vertices: &'a Buffer,
@@ -211,17 +222,17 @@ impl ShadePass {
 
     /// Clears the colour target and the work counters and rasterises every object's mesh into
     /// the G-buffer: the translucent `objects` (position w = index + 1), then the `opaque` ones
-    /// (w = their id + 1, with their reflectance).
+    /// (w = their id + 1, with their reflectance). Either may be empty.
     pub fn record_surface(
         &self,
         rec: &mut Recorder,
+        targets: &SurfaceTargets,
         objects: &[ShadeInputs],
         opaque: &[OpaqueDraw],
         constants: &ShadeConstants,
     ) -> Result<()> {
-        let inputs = objects.first().ok_or_else(|| crate::runtime!("surface: no objects"))?;
-        rec.fill_buffer(inputs.work, 0)?;
-        rec.begin_rendering(&[(inputs.color, Some([0.0; 4]))], None, 0)?;
+        rec.fill_buffer(targets.work, 0)?;
+        rec.begin_rendering(&[(targets.color, Some([0.0; 4]))], None, 0)?;
         rec.end_rendering();
         let translucent = objects.iter().map(|o| (o.vertices, o.indices));
         for (vertices, indices) in translucent.chain(opaque.iter().map(|o| (o.vertices, o.indices))) {
@@ -232,8 +243,8 @@ impl ShadePass {
             rec.prepare_draw_reads(&[Bind::Read(o.uvs), Bind::Sampled(o.texture.0, o.texture.1)])?;
         }
         let clear = Some([0.0; 4]);
-        let targets = [(inputs.position, clear), (inputs.normal, clear), (inputs.albedo, clear)];
-        rec.begin_rendering(&targets, Some((inputs.depth, Some(1.0))), 0)?;
+        let gbuffer = [(targets.position, clear), (targets.normal, clear), (targets.albedo, clear)];
+        rec.begin_rendering(&gbuffer, Some((targets.depth, Some(1.0))), 0)?;
         for (k, o) in objects.iter().enumerate() {
             let mut c = *constants;
             c.point_range.z = k as u32;

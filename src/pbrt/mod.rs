@@ -315,9 +315,15 @@ pub fn render_settings(
             MaterialDesc::Interface => {}
         }
     }
-    let Some(&(_, sub)) = translucent.first() else {
-        return Err(bad_input!("{shown}: no shape with a subsurface material (nothing to render)"));
-    };
+    let sub = translucent.first().map(|&(_, s)| s);
+    if sub.is_none() {
+        if opaque.is_empty() {
+            return Err(bad_input!("{shown}: no shape with a subsurface or diffuse material (nothing to render)"));
+        }
+        crate::note!(
+            "warning: {shown}: no shape with a subsurface material: nothing in the scene is translucent; its diffuse shapes are rendered under its lights"
+        );
+    }
     let mut lights = Vec::new();
     // Every `infinite` light, summed into one environment below (pbrt-v4 adds them).
     let mut environments: Vec<crate::environment::Environment> = Vec::new();
@@ -481,7 +487,10 @@ pub fn render_settings(
     }
     // One scale for the world: the first subsurface material's `scale` (or --scale); other
     // materials' coefficients are multiplied by their scale over it, which is what pbrt does.
-    let mm_per_unit = if given("--scale") { args.scale } else { sub.scale as f32 };
+    let mm_per_unit = match sub {
+        Some(sub) if !given("--scale") => sub.scale as f32,
+        _ => args.scale,
+    };
     let mut objects = Vec::new();
     for &(o, sub) in &translucent {
         let mut material = material_of(sub, args, given)?;
@@ -503,7 +512,7 @@ pub fn render_settings(
         }
         opaque_objects.push(crate::world::Opaque { uvs, ..crate::world::Opaque::new(mesh, reflectance) });
     }
-    if !given("--roughness") {
+    if let Some(sub) = sub.filter(|_| !given("--roughness")) {
         // pbrt: α = √roughness when remapped, else α = roughness; ours: α = roughness².
         let alpha = if sub.remap_roughness { sub.roughness.max(0.0).sqrt() } else { sub.roughness };
         let r = (alpha.max(0.0).sqrt() as f32).clamp(MIN_ROUGHNESS, 1.0);
@@ -530,7 +539,8 @@ pub fn render_settings(
         }
     }
     // Far from unit size: re-expressed in power-of-two units, as scenes from flags are.
-    let (_, radius) = crate::scene::bounding_sphere(&world.objects[0].mesh.positions);
+    let first = world.objects.first().map(|o| &o.mesh).or(world.opaque.first().map(|o| &o.mesh));
+    let (_, radius) = crate::scene::bounding_sphere(&first.expect("a translucent or an opaque shape").positions);
     if let Some(factor) = crate::settings::rescale_factor(radius) {
         for mesh in world.objects.iter_mut().map(|o| &mut o.mesh).chain(world.opaque.iter_mut().map(|o| &mut o.mesh)) {
             mesh.positions.iter_mut().for_each(|p| *p *= factor);

@@ -272,10 +272,10 @@ fn panel_state(
 ) -> panel::PanelState {
     let d = &view.desc;
     panel::PanelState {
-        material: view.material().clone(),
+        material: view.material().cloned(),
         model: d.integration.model,
         epsilon: d.integration.epsilon,
-        samples: view.world.objects[0].samples.or(renderer.point_count()).unwrap_or(0),
+        samples: view.world.objects.first().and_then(|o| o.samples).or(renderer.point_count()).unwrap_or(0),
         exposure,
         specular: d.specular,
         roughness: d.roughness,
@@ -388,8 +388,12 @@ impl Viewer {
         }
         let device_label = device_name.clone();
         let mesh_spec = SceneSettings::from_args(r).mesh_spec();
-        let animation =
-            crate::deform::Animation::new(&mesh_spec, &world.objects[0].mesh, r.deform, r.deform_period, r.up)?;
+        // The first translucent object is the one animated (none in a world of opaque objects).
+        let animation = match world.objects.first() {
+            Some(o) => crate::deform::Animation::new(&mesh_spec, &o.mesh, r.deform, r.deform_period, r.up)?,
+            None if r.deform.is_some() => return Err(bad_input!("--deform: the scene has no translucent object")),
+            None => None,
+        };
         let ui = if args.no_panel {
             None
         } else {
@@ -561,7 +565,8 @@ impl Viewer {
                 // The panel's settings, from the keys.
                 "m" => {
                     let presets = crate::materials::Material::presets();
-                    let now = presets.iter().position(|m| m.name == self.view.material().name).unwrap_or(0);
+                    let name = self.view.material().map(|m| m.name.clone());
+                    let now = presets.iter().position(|m| Some(&m.name) == name.as_ref()).unwrap_or(0);
                     Action::Material(
                         presets[(now + if shift { presets.len() - 1 } else { 1 }) % presets.len()].name.clone(),
                     )

@@ -12,7 +12,8 @@ use crate::scene::Light;
 
 /// What the panel shows: the current settings and the last frames' numbers.
 pub struct PanelState {
-    pub material: crate::materials::Material,
+    /// The first translucent object's material (none where nothing is translucent).
+    pub material: Option<crate::materials::Material>,
     pub model: Model,
     pub epsilon: f32,
     pub samples: u32,
@@ -180,13 +181,17 @@ fn lights_and_environment(ui: &mut egui::Ui, s: &PanelState, actions: &mut Vec<A
 pub fn draw(ctx: &egui::Context, s: &PanelState, actions: &mut Vec<Action>) {
     egui::Window::new("translucent").default_width(260.0).resizable(false).show(ctx, |ui| {
         egui::CollapsingHeader::new("Material").default_open(true).show(ui, |ui| {
-            let mut name = s.material.name.clone();
+            let Some(m) = &s.material else {
+                ui.label("nothing in the scene is translucent");
+                return;
+            };
+            let mut name = m.name.clone();
             egui::ComboBox::from_label("preset").selected_text(&name).show_ui(ui, |ui| {
                 for preset in crate::materials::Material::presets() {
                     ui.selectable_value(&mut name, preset.name.clone(), &preset.name);
                 }
             });
-            if name != s.material.name {
+            if name != m.name {
                 actions.push(Action::Material(name));
             }
             let per_channel = |ui: &mut egui::Ui, label: &str, values: [f64; 3], speed: f64, max: f64| {
@@ -207,7 +212,6 @@ pub fn draw(ctx: &egui::Context, s: &PanelState, actions: &mut Vec<Action>) {
                 });
                 (v != values).then_some(v)
             };
-            let m = &s.material;
             if let Some(v) = per_channel(ui, "σa [1/mm]", m.sigma_a, 0.001, 100.0) {
                 actions.push(Action::Set(Setting::SigmaA(v)));
             }
@@ -243,17 +247,20 @@ pub fn draw(ctx: &egui::Context, s: &PanelState, actions: &mut Vec<Action>) {
             if epsilon != s.epsilon {
                 actions.push(Action::Set(Setting::Epsilon(epsilon)));
             }
+            // The first translucent object's samples (none where nothing is translucent).
             let mut samples = s.samples;
-            let response = ui.add(
-                egui::DragValue::new(&mut samples)
-                    .speed(64)
-                    .range(2..=1 << 20)
-                    .clamp_existing_to_range(false)
-                    .prefix("samples "),
-            );
-            // A new hierarchy per change: only once the drag ends.
-            if samples != s.samples && !response.dragged() {
-                actions.push(Action::Set(Setting::Samples(samples)));
+            if s.material.is_some() {
+                let response = ui.add(
+                    egui::DragValue::new(&mut samples)
+                        .speed(64)
+                        .range(2..=1 << 20)
+                        .clamp_existing_to_range(false)
+                        .prefix("samples "),
+                );
+                // A new hierarchy per change: only once the drag ends.
+                if samples != s.samples && !response.dragged() {
+                    actions.push(Action::Set(Setting::Samples(samples)));
+                }
             }
             let mut auto = s.exposure.is_none();
             let mut stops = s.exposure.unwrap_or(0.0);
@@ -333,7 +340,7 @@ mod tests {
 
     fn state(material: crate::materials::Material) -> PanelState {
         PanelState {
-            material,
+            material: Some(material),
             model: Model::Directional,
             epsilon: 0.1,
             samples: 4096,
@@ -446,10 +453,13 @@ mod tests {
         // Values the widgets' ranges do not cover, as the command line may set them.
         (unusual.epsilon, unusual.roughness, unusual.exposure, unusual.samples) = (0.0, 0.01, Some(12.0), 1 << 21);
         unusual.show = Show::Tree(40);
-        unusual.material.eta = 0.8;
-        let states = crate::materials::Material::presets().into_iter().map(state).chain([unusual]);
+        unusual.material.as_mut().unwrap().eta = 0.8;
+        // Nothing translucent: no material, no samples.
+        let mut opaque_only = state(crate::materials::Material::find("marble").unwrap());
+        (opaque_only.material, opaque_only.samples) = (None, 0);
+        let states = crate::materials::Material::presets().into_iter().map(state).chain([unusual, opaque_only]);
         for s in states {
-            let material = s.material.clone();
+            let name = s.material.as_ref().map_or("no material".to_string(), |m| m.name.clone());
             for _ in 0..3 {
                 let mut actions = Vec::new();
                 let input = egui::RawInput {
@@ -457,7 +467,7 @@ mod tests {
                     ..Default::default()
                 };
                 let _ = ctx.run_ui(input, |ui| draw(ui.ctx(), &s, &mut actions));
-                assert!(actions.is_empty(), "{}: {actions:?}", material.name);
+                assert!(actions.is_empty(), "{name}: {actions:?}");
             }
         }
     }

@@ -44,7 +44,10 @@ pub enum Applied {
 
 impl ViewState {
     pub fn new(world: World, desc: FrameDesc) -> ViewState {
-        let centre = world.objects.first().map(|o| crate::scene::bounding_sphere(&o.mesh.positions).0);
+        // Lights turn about the first object's centre (the first opaque one's where nothing is
+        // translucent).
+        let first = world.objects.first().map(|o| &o.mesh).or(world.opaque.first().map(|o| &o.mesh));
+        let centre = first.map(|mesh| crate::scene::bounding_sphere(&mesh.positions).0);
         let exposure_stops = match desc.exposure {
             Exposure::Stops(s) => s,
             Exposure::Auto => 0.0,
@@ -122,15 +125,22 @@ impl ViewState {
         Ok(())
     }
 
-    /// The material of the (first) object.
-    pub fn material(&self) -> &Material {
-        &self.world.objects[0].material
+    /// The material of the (first) translucent object; none in a world of opaque objects only.
+    pub fn material(&self) -> Option<&Material> {
+        self.world.objects.first().map(|o| &o.material)
+    }
+
+    /// The first translucent object, for an edit of its material or its samples (refused where
+    /// nothing is translucent).
+    fn first_object(&mut self) -> Result<&mut crate::world::Object> {
+        let none = || crate::bad_input!("the scene has no translucent object: no material or samples to edit");
+        self.world.objects.first_mut().ok_or_else(none)
     }
 
     /// Applies one action: the one path for scripts, keys, the mouse and the panel. An edit that
     /// the checks refuse (g ≥ 1 typed on the panel, σ beyond f32) leaves everything as it was.
     pub fn apply(&mut self, action: Action) -> Result<Applied> {
-        let (desc_before, material_before) = (self.desc.clone(), self.material().clone());
+        let (desc_before, material_before) = (self.desc.clone(), self.material().cloned());
         let before = (self.exposure_stops, self.env_lights, self.env_frame, self.env_rotate_deg);
         let own = self.own_lights().len();
         let light_index = |k: usize| {
@@ -164,28 +174,36 @@ impl ViewState {
             Action::RemoveLight(k) => {
                 d.lights.remove(light_index(k)?);
             }
-            Action::Material(name) => self.world.objects[0].material = Material::find(&name)?,
-            Action::TogglePause => self.playing = !self.playing,
-            Action::Set(setting) => {
-                let m = &mut self.world.objects[0].material;
-                match setting {
-                    Setting::Epsilon(e) => d.integration.epsilon = e,
-                    Setting::Exposure(stops) => {
-                        self.exposure_stops = stops.unwrap_or(0.0);
-                        d.exposure = stops.map(Exposure::Stops).unwrap_or(Exposure::Auto);
-                    }
-                    Setting::Specular(on) => d.specular = on,
-                    Setting::Roughness(r) => d.roughness = r,
-                    Setting::Model(model) => d.integration.model = model,
-                    Setting::BruteForce(on) => d.integration.brute_force = on,
-                    Setting::SigmaA(v) => m.sigma_a = v,
-                    Setting::SigmaS(v) => m.sigma_s = v,
-                    Setting::G(v) => m.g = v,
-                    Setting::Eta(v) => m.eta = v,
-                    Setting::Samples(n) => self.world.objects[0].samples = Some(n),
-                    Setting::Show(show) => d.show = show,
-                }
+            Action::Material(name) => {
+                let material = Material::find(&name)?;
+                self.first_object()?.material = material;
             }
+            Action::TogglePause => self.playing = !self.playing,
+            Action::Set(setting) => match setting {
+                Setting::Epsilon(e) => d.integration.epsilon = e,
+                Setting::Exposure(stops) => {
+                    self.exposure_stops = stops.unwrap_or(0.0);
+                    d.exposure = stops.map(Exposure::Stops).unwrap_or(Exposure::Auto);
+                }
+                Setting::Specular(on) => d.specular = on,
+                Setting::Roughness(r) => d.roughness = r,
+                Setting::Model(model) => d.integration.model = model,
+                Setting::BruteForce(on) => d.integration.brute_force = on,
+                Setting::Show(show) => d.show = show,
+                // The first translucent object's material and samples.
+                of_object => {
+                    let o = self.first_object()?;
+                    let m = &mut o.material;
+                    match of_object {
+                        Setting::SigmaA(v) => m.sigma_a = v,
+                        Setting::SigmaS(v) => m.sigma_s = v,
+                        Setting::G(v) => m.g = v,
+                        Setting::Eta(v) => m.eta = v,
+                        Setting::Samples(n) => o.samples = Some(n),
+                        _ => unreachable!("the frame's settings are matched above"),
+                    }
+                }
+            },
             window => return Ok(Applied::Window(window)),
         }
         self.checked(desc_before, material_before, before)
@@ -195,12 +213,16 @@ impl ViewState {
     fn checked(
         &mut self,
         desc_before: FrameDesc,
-        material_before: Material,
+        material_before: Option<Material>,
         before: (f32, usize, glam::Mat3, f32),
     ) -> Result<Applied> {
-        let checked = crate::world::check_material(self.material()).and_then(|_| self.desc.validate());
+        let material = self.material().map_or(Ok(()), crate::world::check_material);
+        let checked = material.and_then(|_| self.desc.validate());
         if let Err(e) = checked {
-            (self.desc, self.world.objects[0].material) = (desc_before, material_before);
+            self.desc = desc_before;
+            if let (Some(o), Some(m)) = (self.world.objects.first_mut(), material_before) {
+                o.material = m;
+            }
             (self.exposure_stops, self.env_lights, self.env_frame, self.env_rotate_deg) = before;
             return Err(e);
         }
@@ -234,7 +256,7 @@ mod tests {
         assert_eq!(s.desc.integration.model, Model::Dipole);
         assert!(s.desc.integration.brute_force);
         assert_eq!(s.world.objects[0].samples, Some(5000));
-        assert_eq!(s.material().name, Material::find("skin1").unwrap().name);
+        assert_eq!(s.material().unwrap().name, Material::find("skin1").unwrap().name);
         assert_eq!(s.apply(Action::Quit).unwrap(), Applied::Window(Action::Quit));
     }
 
@@ -284,14 +306,37 @@ mod tests {
     #[test]
     fn refused_edits_change_nothing() {
         let mut s = state();
-        let material = s.material().clone();
+        let material = s.material().unwrap().clone();
         let e = s.apply(Action::Set(Setting::SigmaS([1e7; 3]))).unwrap_err();
         assert!(e.to_string().contains("f32"), "{e}");
-        assert_eq!(s.material(), &material);
+        assert_eq!(s.material(), Some(&material));
         let e = s.apply(Action::Set(Setting::Epsilon(f32::NAN))).unwrap_err();
         assert!(e.to_string().contains("--epsilon"), "{e}");
         assert_eq!(s.desc.integration.epsilon, crate::frame_desc::DEFAULT_EPSILON);
         s.apply(Action::Set(Setting::G([1.5; 3]))).unwrap_err();
-        assert_eq!(s.material(), &material);
+        assert_eq!(s.material(), Some(&material));
+    }
+
+    /// Nothing translucent (a scene of diffuse shapes, issue #28): the frame's settings and the
+    /// lights are edited; the material and the samples are refused, changing nothing.
+    #[test]
+    fn a_world_of_opaque_objects_edits_all_but_the_material() {
+        let mut s = state();
+        let opaque =
+            crate::world::Opaque::new(Mesh::sphere(1.0, 8), crate::world::Reflectance::Constant(Vec3::splat(0.5)));
+        (s.world.objects, s.world.opaque) = (Vec::new(), vec![opaque]);
+        assert_eq!(s.material(), None);
+        assert_eq!(s.apply(Action::Set(Setting::Roughness(0.5))).unwrap(), Applied::Edited);
+        assert_eq!(s.apply(Action::Set(Setting::Show(crate::frame_desc::Show::Samples))).unwrap(), Applied::Edited);
+        s.apply(Action::AddLight(Light::Directional { toward: Vec3::X, irradiance: Vec3::ONE })).unwrap();
+        assert_eq!(s.own_lights().len(), 2);
+        let world = s.world.clone();
+        for refused in
+            [Action::Material("skin1".into()), Action::Set(Setting::G([0.5; 3])), Action::Set(Setting::Samples(5000))]
+        {
+            let e = s.apply(refused).unwrap_err();
+            assert!(e.to_string().contains("no translucent object"), "{e}");
+        }
+        assert_eq!(s.world, world);
     }
 }
