@@ -81,11 +81,6 @@ const uint MAX_STEPS = 32768u;
 vec3 own_irradiance;
 vec4 own_incident[3];
 bool own_lit = false;
-// The control variate's light: the pixel's own irradiance and flux where it is lit, else a unit
-// irradiance at normal incidence, so that the variate's share (near_blend in main) is known at
-// every pixel, from the geometry alone (set by own_light()).
-vec3 variate_irradiance;
-vec4 variate_incident[3];
 // The control variate's sum, −Σ v_i Sd_i A_i under the variate's light (near_correction()), and
 // Σ v_i f_i, the sources' own contributions weighted by the same v_i (near_blend in main).
 vec3 near_sum = vec3(0.0);
@@ -202,7 +197,9 @@ vec3 unfolded(vec3 xi, vec3 ni, vec3 xo, vec3 no) {
 // by the pixel's own irradiance and lights (see near_field()); `made` counts the evaluations.
 // Adds to near_sum; returns v, the source's weight in it (0 beyond reach).
 float near_correction(vec3 xi, vec3 ni, float area, vec3 xo, vec3 no, inout uint made) {
-    if (!NEAR_FIELD || dot(ni, no) < NEAR_UNFOLD_MIN_COS) return 0.0;
+    // An unlit pixel has no variate: a SIMD group or warp of unlit pixels (the dark side of a
+    // back-lit object, most of the default image) skips it whole.
+    if (!NEAR_FIELD || !own_lit || dot(ni, no) < NEAR_UNFOLD_MIN_COS) return 0.0;
     vec3 x = unfolded(xi, ni, xo, no);
     // A fold carries a source no nearer than it lies (the way through the fold is no shorter
     // than the straight line), so an unfolded place nearer than the source itself is no fold:
@@ -214,10 +211,10 @@ float near_correction(vec3 xi, vec3 ni, float area, vec3 xo, vec3 no, inout uint
     if (v <= 0.0) return 0.0;
     ++made;
     vec4 flux[3];
-    for (uint c = 0u; c < 3u; ++c) flux[c] = variate_incident[c] * (v * area);
+    for (uint c = 0u; c < 3u; ++c) flux[c] = own_incident[c] * (v * area);
     // At the pixel's normal, as the plane integral has it: the pixel's lights refracted at ni
     // would make a different function (near a terminator, lights below ni's horizon).
-    near_sum -= merged_source(x, no, variate_irradiance * (v * area), flux, vec3(0.0), xo, no, false);
+    near_sum -= merged_source(x, no, own_irradiance * (v * area), flux, vec3(0.0), xo, no, false);
     return v;
 }
 
@@ -266,15 +263,13 @@ void own_light(vec3 xo, vec3 no) {
         own_irradiance += e;
     }
     own_lit = own_irradiance != vec3(0.0);
-    variate_irradiance = own_lit ? own_irradiance : vec3(1.0);
-    vec4 normal_incidence = flux_term(no, no);
-    for (uint c = 0u; c < 3u; ++c) variate_incident[c] = own_lit ? own_incident[c] : normal_incidence;
 }
 
 vec3 near_field(vec3 xo, vec3 no, out uint made) {
     made = 0u;
-    vec3 e = variate_irradiance;
-    vec4 incident[3] = variate_incident;
+    if (!own_lit) return vec3(0.0);
+    vec3 e = own_irradiance;
+    vec4 incident[3] = own_incident;
     vec3 toward_mean = incident[0].xyz * 0.2126 + incident[1].xyz * 0.7152 + incident[2].xyz * 0.0722;
     float s = object_params.mm_per_unit;
     float start = object_params.near_start_mm, end = object_params.near_end_mm, scale = object_params.near_scale_mm;
@@ -760,7 +755,9 @@ void main() {
         // from the pixel), which is exactly where the variate alone went negative at a shadow's
         // or terminator's edge. It is a ratio of two sums under the same light: the geometry's
         // alone but for the directional dipole's mean direction, so the image stays linear in
-        // the lights. Brute force's draws each see part of the points, so it keeps γ = 0.
+        // the lights but where a pixel is lit by some lights and not others (an unlit pixel has
+        // no variate and γ = 0: measured 16 lights against 8 + 8 in tests/image_quality.rs).
+        // Brute force's draws each see part of the points, so it keeps γ = 0.
         bool tree = frame_params.brute_force == 0u && object_params.node_count != 0u;
         vec3 points_estimate = -near_sum;
         vec3 blend = vec3(0.0);
@@ -768,9 +765,7 @@ void main() {
             if (tree && points_estimate[c] > integral[c]) blend[c] = 1.0 - integral[c] / points_estimate[c];
         }
         sum -= blend * near_sources;
-        // The variate's own-irradiance term, where the pixel is lit (an unlit pixel's variate
-        // light is only there for the blend).
-        if (own_lit) sum += integral - (1.0 - blend) * points_estimate;
+        sum += integral - (1.0 - blend) * points_estimate;
     }
     // Helper invocations' atomics have no effect (Vulkan spec), so only real pixels count.
     if (frame_params.count_work != 0u) {
