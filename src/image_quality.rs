@@ -1,6 +1,6 @@
 //! Checks of a rendered image that a mean or an RMSE does not see: negative light, and isolated
-//! dots (speckles) that an estimator with the right mean can still leave. Used by the tests and
-//! by `translucent compare`, so a user runs the same checks on their own renders.
+//! dots (speckles) that an estimator with the right mean can still leave. Used by the tests
+//! (tests/image_quality.rs, tests/convergence.rs).
 
 use crate::output::{luminance, HdrImage};
 

@@ -118,7 +118,7 @@ fn default_images_converge_on_a_sphere() {
 /// A flat slab with sharp edges, where the sample pattern showed as a moiré. Measured (48²,
 /// 42,626 points): directional 0.47 / 0.60 / 0.87% (without 0.76 / 1.69 / 4.08%), dipole 0.29 /
 /// 0.44 / 0.69% (0.30 / 0.46 / 0.83%), mc 0.24 / 0.28 / 0.34% (0.31 / 0.66 / 1.07%), pbd 0.44 /
-/// 0.83 / 1.43% (5.66 / 12.98 / 26.02%). Before the control variate unfolded the surface it faded
+/// 0.83 / 1.43% (5.66 / 12.98 / 26.02%); 0.56 / 1.08 / 1.79% since issue #27's blend. Before the control variate unfolded the surface it faded
 /// out at the box's edges and left them the plain sum: directional 2.13% and pbd 18.0% in blue at
 /// this spacing; before lit nodes took their sources' normal, the unlit front face was 2-4% too
 /// bright in red (the directional dipole, 1.22% RMSE). pbd's blue misses the 1%: five pixels on
