@@ -139,12 +139,7 @@ fn screenshot_equals_render_with_the_same_settings() {
     let mut render = vec!["render", "--validation"];
     render.extend_from_slice(SCENE);
     render.extend_from_slice(&["--light-dir", "-0.5,0.8,0.6", "--out", rendered.to_str().unwrap()]);
-    let out = translucent(&render);
-    assert!(out.status.success(), "{}", stderr(&out));
-
-    let diff = output::compare(&load(&shot), &load(&rendered)).unwrap();
-    // The same frame code on the same device: equal but for nothing.
-    assert!(diff.rmse < 0.5 && diff.differing_fraction < 0.001, "{diff:?}");
+    assert_screenshot_equals_render(&shot, &render, &rendered);
 }
 
 #[test]
@@ -557,10 +552,7 @@ fn environment_and_lights_edited_in_the_viewer_equal_render() {
         "--out",
         rendered.to_str().unwrap(),
     ]);
-    let out = translucent(&render);
-    assert!(out.status.success(), "{}", stderr(&out));
-    let diff = output::compare(&load(&shot), &load(&rendered)).unwrap();
-    assert!(diff.rmse < 0.5 && diff.differing_fraction < 0.001, "{diff:?}");
+    assert_screenshot_equals_render(&shot, &render, &rendered);
 }
 
 /// A scene of `diffuse` shapes only (issue #28) in the viewer: the warning that nothing is
@@ -610,4 +602,13 @@ Shape "trianglemesh" "integer indices" [ 0 2 1 0 3 2 ] "point3 P" [ -4 0 -4 4 0 
     let err = stderr(&out);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains("line 1") && err.contains("no translucent object"), "{err}");
+}
+
+/// Runs `render` (arguments writing `rendered`) and asserts the viewer's screenshot `shot` equals
+/// it: the same frame code on the same device, equal but for nothing.
+fn assert_screenshot_equals_render(shot: &Path, render: &[&str], rendered: &Path) {
+    let out = translucent(render);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let diff = output::compare(&load(shot), &load(rendered)).unwrap();
+    assert!(diff.rmse < 0.5 && diff.differing_fraction < 0.001, "{diff:?}");
 }

@@ -540,7 +540,9 @@ pub fn render_settings(
     }
     // Far from unit size: re-expressed in power-of-two units, as scenes from flags are.
     let first = world.objects.first().map(|o| &o.mesh).or(world.opaque.first().map(|o| &o.mesh));
-    let (_, radius) = crate::scene::bounding_sphere(&first.expect("a translucent or an opaque shape").positions);
+    let first =
+        first.ok_or_else(|| bad_input!("{}: no shape with a subsurface or diffuse material", path.display()))?;
+    let (_, radius) = crate::scene::bounding_sphere(&first.positions);
     if let Some(factor) = crate::settings::rescale_factor(radius) {
         for mesh in world.objects.iter_mut().map(|o| &mut o.mesh).chain(world.opaque.iter_mut().map(|o| &mut o.mesh)) {
             mesh.positions.iter_mut().for_each(|p| *p *= factor);
