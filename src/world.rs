@@ -25,12 +25,19 @@ pub struct Object {
     pub transform: Mat4,
     /// Sample points over its surface (`None`: from the material's length scales and its area).
     pub samples: Option<u32>,
+    /// A colour over the surface: the total diffuse reflectance per channel (linear, in [0, 1])
+    /// at each uv, which sets the material's albedo there (the material keeps its mean free
+    /// path). `None`: the material alone, the same everywhere. A checkerboard or an image needs
+    /// `uvs`.
+    pub texture: Option<Reflectance>,
+    /// One per vertex of `mesh`, when it has them.
+    pub uvs: Option<Vec<Vec2>>,
 }
 
 impl Object {
     /// `mesh` in `material`, where it is (identity transform), with the default sample count.
     pub fn new(mesh: Mesh, material: Material) -> Object {
-        Object { mesh, material, transform: Mat4::IDENTITY, samples: None }
+        Object { mesh, material, transform: Mat4::IDENTITY, samples: None, texture: None, uvs: None }
     }
 
     /// The mesh in world coordinates: positions by the transform, normals by its inverse
@@ -169,39 +176,37 @@ impl Opaque {
             return Err(bad_input!("an opaque object's transform is not finite or not invertible"));
         }
         self.world_mesh().validate()?;
-        let in_range = |c: Vec3| c.is_finite() && c.min_element() >= 0.0 && c.max_element() <= 1.0;
-        let ok = match self.reflectance {
-            Reflectance::Constant(c) => in_range(c),
-            Reflectance::Checkerboard { uscale, vscale, tex1, tex2 } => {
-                if self.uvs.is_none() {
-                    return Err(bad_input!("a checkerboard reflectance needs the mesh's uv coordinates"));
-                }
-                uscale.is_finite() && vscale.is_finite() && in_range(tex1) && in_range(tex2)
-            }
-            Reflectance::Image(ref t) => {
-                if self.uvs.is_none() {
-                    return Err(bad_input!("{}: an image reflectance needs the mesh's uv coordinates", t.name));
-                }
-                t.texels.len() == (t.width * t.height) as usize
-            }
-        };
-        if !ok {
-            return Err(bad_input!(
-                "reflectance {:?}: each channel must be within [0, 1] (and scales finite)",
-                self.reflectance
-            ));
-        }
-        if let Some(uvs) = &self.uvs {
-            if uvs.len() != self.mesh.positions.len() || uvs.iter().any(|uv| !uv.is_finite()) {
-                return Err(bad_input!(
-                    "{} uv coordinates for {} vertices, or not finite",
-                    uvs.len(),
-                    self.mesh.positions.len()
-                ));
-            }
-        }
-        Ok(())
+        check_reflectance(&self.reflectance, self.uvs.as_deref(), self.mesh.positions.len())
     }
+}
+
+/// A reflectance within [0, 1] per channel, with the uv per vertex a checkerboard or an image needs.
+fn check_reflectance(reflectance: &Reflectance, uvs: Option<&[Vec2]>, vertex_count: usize) -> Result<()> {
+    let in_range = |c: Vec3| c.is_finite() && c.min_element() >= 0.0 && c.max_element() <= 1.0;
+    let ok = match reflectance {
+        Reflectance::Constant(c) => in_range(*c),
+        Reflectance::Checkerboard { uscale, vscale, tex1, tex2 } => {
+            if uvs.is_none() {
+                return Err(bad_input!("a checkerboard reflectance needs the mesh's uv coordinates"));
+            }
+            uscale.is_finite() && vscale.is_finite() && in_range(*tex1) && in_range(*tex2)
+        }
+        Reflectance::Image(t) => {
+            if uvs.is_none() {
+                return Err(bad_input!("{}: an image reflectance needs the mesh's uv coordinates", t.name));
+            }
+            t.texels.len() == (t.width * t.height) as usize
+        }
+    };
+    if !ok {
+        return Err(bad_input!("reflectance {reflectance:?}: each channel must be within [0, 1] (and scales finite)"));
+    }
+    if let Some(uvs) = uvs {
+        if uvs.len() != vertex_count || uvs.iter().any(|uv| !uv.is_finite()) {
+            return Err(bad_input!("{} uv coordinates for {vertex_count} vertices, or not finite", uvs.len()));
+        }
+    }
+    Ok(())
 }
 
 /// Everything drawn, in one scale.
@@ -236,6 +241,9 @@ impl World {
             }
             check_geometry(&object.world_mesh(), self.mm_per_unit)?;
             check_material(&object.material)?;
+            if let Some(texture) = &object.texture {
+                check_reflectance(texture, object.uvs.as_deref(), object.mesh.positions.len())?;
+            }
         }
         Ok(())
     }
