@@ -305,10 +305,18 @@ pub struct DeviceArgs {
 
 #[derive(Args, Debug, Clone)]
 pub struct RenderArgs {
-    /// A pbrt-v4 scene file (`scene.pbrt`): its camera, film, shape, material and lights; flags
-    /// typed here override them (see README, "Scenes").
-    #[arg(value_name = "SCENE.pbrt")]
+    /// A scene file: pbrt-v4 (`scene.pbrt`: its camera, film, shapes, materials and lights) or
+    /// glTF 2.0 (`scene.gltf`, `scene.glb`: its meshes, materials, punctual lights and camera);
+    /// flags typed here override them (see README, "Scenes and mesh files").
+    #[arg(value_name = "SCENE.pbrt|SCENE.gltf|SCENE.glb")]
     pub scene: Option<PathBuf>,
+    /// The scene of a glTF file to render, numbered from 0 (default: the file's `scene`, else 0).
+    #[arg(long, value_name = "N")]
+    pub gltf_scene: Option<usize>,
+    /// Render the glTF material named NAME translucent, as the preset PRESET (repeatable; the
+    /// coefficient flags still apply).
+    #[arg(long, value_name = "NAME=PRESET")]
+    pub gltf_material: Vec<String>,
     /// Mesh: `sphere`, `box`, `slab`, `torus`, or the path of a mesh file: `.obj`, `.ply`, `.off`,
     /// any of them gzip-compressed (`.ply.gz`) (default: the Stanford bunny from glmark2-data when
     /// installed, else the sphere). A `{frame}` in the path plays a sequence of files, one per

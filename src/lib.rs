@@ -14,6 +14,7 @@ pub mod error;
 pub mod export;
 pub mod frame;
 pub mod frame_desc;
+pub mod gltf;
 pub mod gpu;
 pub mod gpu_world;
 pub mod hierarchy;

@@ -277,3 +277,17 @@ pub fn environment_radiance(spec: &str) -> Result<crate::environment::Radiance> 
     };
     Ok(radiance)
 }
+
+/// The settings of a scene file, `render SCENE` or `view SCENE`: glTF 2.0 (`.gltf`, `.glb`) or
+/// pbrt-v4 (anything else), with the flags typed on the command line (`given`) overriding it.
+pub fn scene_file_settings(
+    path: &std::path::Path,
+    args: &RenderArgs,
+    given: &dyn Fn(&str) -> bool,
+) -> Result<(RenderArgs, RenderSettings)> {
+    if crate::gltf::is_gltf(path) {
+        crate::gltf::render_settings(path, args, given)
+    } else {
+        crate::pbrt::render_settings(path, args, given)
+    }
+}

@@ -118,9 +118,33 @@ impl Texture {
         if !meta.is_file() {
             return Err(bad_input!("{shown}: not a regular file"));
         }
-        let reader = image::ImageReader::open(path).map_err(|e| bad_input!("{shown}: {e}"))?;
-        let reader = reader.with_guessed_format().map_err(|e| bad_input!("{shown}: {e}"))?;
-        let (width, height) = reader.into_dimensions().map_err(|e| bad_input!("{shown}: not an image: {e}"))?;
+        let open = || {
+            let reader = image::ImageReader::open(path).map_err(|e| bad_input!("{shown}: {e}"))?;
+            reader.with_guessed_format().map_err(|e| bad_input!("{shown}: {e}"))
+        };
+        Texture::decode(open, ext == "exr", shown)
+    }
+
+    /// An image file's bytes (PNG or JPEG, sRGB-encoded, decoded to linear; EXR when `linear`),
+    /// the format guessed from its first bytes; checked as [`Texture::load`] checks a file.
+    pub fn from_bytes(bytes: &[u8], linear: bool, shown: &str) -> Result<Texture> {
+        let open = || {
+            image::ImageReader::new(std::io::Cursor::new(bytes))
+                .with_guessed_format()
+                .map_err(|e| bad_input!("{shown}: {e}"))
+        };
+        Texture::decode(open, linear, shown)
+    }
+
+    /// The one decoder: the size from the header checked against [`MAX_TEXTURE_SIDE`] and
+    /// [`MAX_TEXTURE_TEXELS`] before decoding (`open` gives a fresh reader for each step), then
+    /// linear RGB, every texel within [0, 1].
+    fn decode<R: std::io::BufRead + std::io::Seek>(
+        open: impl Fn() -> Result<image::ImageReader<R>>,
+        linear: bool,
+        shown: &str,
+    ) -> Result<Texture> {
+        let (width, height) = open()?.into_dimensions().map_err(|e| bad_input!("{shown}: not an image: {e}"))?;
         let texels = width as u64 * height as u64;
         if width == 0
             || height == 0
@@ -132,8 +156,7 @@ impl Texture {
                 "{shown}: {width}x{height}: a texture's sides must be between 1 and {MAX_TEXTURE_SIDE}, and it may have at most {MAX_TEXTURE_TEXELS} texels"
             ));
         }
-        let img = image::open(path).map_err(|e| bad_input!("{shown}: not an image: {e}"))?.into_rgba32f();
-        let linear = ext == "exr";
+        let img = open()?.decode().map_err(|e| bad_input!("{shown}: not an image: {e}"))?.into_rgba32f();
         let decode = |c: f32| {
             if linear {
                 c
@@ -148,6 +171,17 @@ impl Texture {
             return Err(bad_input!("{shown}: reflectance {:?}: every texel must be finite and within [0, 1]", &t[..3]));
         }
         Ok(Texture { name: shown.to_string(), width, height, texels: std::sync::Arc::new(texels) })
+    }
+
+    /// The mean texel per channel (linear reflectance).
+    pub fn mean(&self) -> [f64; 3] {
+        let mut sum = [0.0f64; 3];
+        for t in self.texels.iter() {
+            for (s, &c) in sum.iter_mut().zip(&t[..3]) {
+                *s += c as f64;
+            }
+        }
+        sum.map(|s| s / self.texels.len().max(1) as f64)
     }
 }
 

@@ -14,7 +14,8 @@ pub(super) fn render(args: &RenderArgs) -> Result<i32> {
     // Check everything the user typed before the (slow) device start.
     if let Some(scene) = &args.scene {
         let argv: Vec<String> = std::env::args().collect();
-        let (args, settings) = crate::pbrt::render_settings(scene, args, &|f| crate::pbrt::flag_given(&argv, f))?;
+        let (args, settings) =
+            crate::settings::scene_file_settings(scene, args, &|f| crate::pbrt::flag_given(&argv, f))?;
         return render_settings(&args, settings);
     }
     render_settings(args, RenderSettings::from_args(args)?)

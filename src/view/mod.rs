@@ -72,7 +72,7 @@ pub fn run(args: &ViewArgs) -> Result<i32> {
         Some(scene) => {
             let argv: Vec<String> = std::env::args().collect();
             let (render, settings) =
-                crate::pbrt::render_settings(scene, &args.render, &|f| crate::pbrt::flag_given(&argv, f))?;
+                crate::settings::scene_file_settings(scene, &args.render, &|f| crate::pbrt::flag_given(&argv, f))?;
             from_scene = ViewArgs { render, ..args.clone() };
             (&from_scene, settings)
         }
