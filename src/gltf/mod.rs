@@ -183,6 +183,7 @@ fn parse_override(spec: &str) -> Result<(&str, &str)> {
 /// A translucent glTF material as the renderer takes it (the flags' preset or coefficients
 /// override it as they override a pbrt scene's).
 fn material_of(
+    shown: &str,
     desc: &MaterialDesc,
     preset: Option<&str>,
     mm_per_unit: f32,
@@ -201,7 +202,8 @@ fn material_of(
             )
         })?,
         None => {
-            let mfp = desc.mfp().ok_or_else(|| bad_input!("{}: no attenuation distance or thickness", desc.path))?;
+            let mfp =
+                desc.mfp().ok_or_else(|| bad_input!("{shown}: {}: no attenuation distance or thickness", desc.path))?;
             let mfp_mm = mfp.map(|l| l * mm_per_unit as f64);
             let top = {
                 // The largest reflectance the dipole reaches for this η (from_reflectance refuses it).
@@ -214,16 +216,16 @@ fn material_of(
             let reflectance = wanted.map(|r| r.min(top * 0.999));
             if reflectance != wanted {
                 crate::note!(
-                    "warning: {}: reflectance {wanted:?} is above what the dipole reaches for ior {} ({top:.4}); rendered at {:.4}",
+                    "warning: {shown}: {}: reflectance {wanted:?} is above what the dipole reaches for ior {} ({top:.4}); rendered at {:.4}",
                     desc.path,
                     desc.ior,
                     top * 0.999
                 );
             }
             let (sigma_a, sigma_s) = crate::pbrt::from_reflectance(reflectance, mfp_mm, desc.anisotropy, desc.ior)
-                .map_err(|e| bad_input!("{}: {e}", desc.path))?;
+                .map_err(|e| bad_input!("{shown}: {}: {e}", desc.path))?;
             let mut mat = crate::materials::Material::custom(sigma_a, sigma_s, [desc.anisotropy; 3], desc.ior)
-                .map_err(|e| bad_input!("{}: {e}", desc.path))?;
+                .map_err(|e| bad_input!("{shown}: {}: {e}", desc.path))?;
             mat.name = format!("glTF {}", desc.path);
             mat
         }
@@ -295,7 +297,7 @@ pub fn render_settings(
             first_translucent.get_or_insert(desc);
             translucent_paths.push(&o.path);
             let preset = preset_of(desc);
-            let material = material_of(desc, preset, mm_per_unit, args, given)?;
+            let material = material_of(&shown.to_string(), desc, preset, mm_per_unit, args, given)?;
             let mut object = crate::world::Object::new(mesh, material);
             object.samples = args.samples;
             // The texture, carried for the shading to use per point (the material is its mean's).

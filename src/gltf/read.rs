@@ -71,6 +71,22 @@ pub fn load(path: &Path, scene: Option<usize>) -> Result<GltfScene> {
             ));
         }
     }
+    // Draco-compressed primitives whose accessors have no data of their own (the crate's
+    // validation would call them a missing bufferView): refused by name.
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            let draco = prim.extensions.as_ref().is_some_and(|e| e.others.contains_key("KHR_draco_mesh_compression"));
+            let no_data = prim
+                .attributes
+                .values()
+                .any(|a| root.accessors.get(a.value()).is_some_and(|a| a.buffer_view.is_none()));
+            if draco && no_data {
+                return Err(bad_input!(
+                    "{shown}: meshes[{m}].primitives[{p}].extensions.KHR_draco_mesh_compression: Draco-compressed meshes are not read (the file has no uncompressed copy)"
+                ));
+            }
+        }
+    }
     // The crate's own check of required extensions knows fewer than we read: ours is above.
     root.extensions_required.clear();
     let document = ::gltf::Document::from_json(root).map_err(|e| match e {
