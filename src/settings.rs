@@ -195,6 +195,11 @@ impl RenderSettings {
     /// rest of the frame and the world.
     pub fn from_args(args: &RenderArgs) -> Result<RenderSettings> {
         check_roughness(args.roughness, "--roughness")?;
+        let gltf = args.scene.as_deref().is_some_and(crate::gltf::is_gltf);
+        if !gltf && (args.gltf_scene.is_some() || !args.gltf_material.is_empty()) {
+            let flag = if args.gltf_scene.is_some() { "--gltf-scene" } else { "--gltf-material" };
+            return Err(bad_input!("{flag}: only for a glTF scene file (render SCENE.gltf|SCENE.glb …)"));
+        }
         let mut scene = SceneSettings::from_args(args).build()?;
         let environment = match &args.env {
             Some(spec) => {

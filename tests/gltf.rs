@@ -992,6 +992,10 @@ fn every_refusal_names_the_file_and_the_json_path() {
     doc.json["meshes"][0]["primitives"][0]["material"] = json!(0);
     let path = doc.write_external(&d, "huge");
     refused(&path, &[], "images[0]: 20000x20000", "at most 16777216 texels");
+    // The glTF flags without a glTF file.
+    let out = render(&["--gltf-scene", "1"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(common::stderr(&out).contains("--gltf-scene: only for a glTF scene file"), "{}", common::stderr(&out));
     // Through the binary: exit 2, `error: FILE: PATH: …`.
     let mut doc = triangle();
     doc.json["meshes"][0]["primitives"][0]["mode"] = json!(3);

@@ -66,7 +66,7 @@ pub fn run(args: &ViewArgs) -> Result<i32> {
         Some(p) => controls::load_script(p)?,
         None => Vec::new(),
     };
-    // A scene file (`view SCENE.pbrt`) as `render` reads it: its film is the window's size.
+    // A scene file (`view SCENE.pbrt`, `view SCENE.gltf`) as `render` reads it: its film (or camera) sizes the window.
     let from_scene;
     let (args, settings) = match &args.render.scene {
         Some(scene) => {
