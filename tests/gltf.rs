@@ -1013,14 +1013,14 @@ fn every_refusal_names_the_file_and_the_json_path() {
 fn reference(view: &[u8], l: &Layout) -> Option<Vec<f32>> {
     let size = l.component.size() as u64;
     let element = size * l.width as u64;
-    if l.count == 0 || l.count > 1 << 25 || !(1..=4).contains(&l.width) || l.offset % size != 0 {
+    if l.count == 0 || l.count > 1 << 25 || !(1..=4).contains(&l.width) || !l.offset.is_multiple_of(size) {
         return None;
     }
     if l.normalized && matches!(l.component, Component::U32 | Component::F32) {
         return None;
     }
     let step = match l.stride {
-        Some(s) if s < element || s > 252 || s % size != 0 => return None,
+        Some(s) if s < element || s > 252 || !s.is_multiple_of(size) => return None,
         Some(s) => s,
         None => element,
     };

@@ -324,7 +324,7 @@ pub fn render_settings(
     }
 
     // Lights: the file's, unless the flags give some (or it has none: the default light).
-    let mut lights: Vec<Light> = scene.lights.iter().map(|l| l.light.clone()).collect();
+    let mut lights: Vec<Light> = scene.lights.iter().map(|l| l.light).collect();
     let flags_light = given("--light") || given("--light-dir") || given("--light-intensity") || given("--env");
     if flags_light || lights.is_empty() {
         if lights.is_empty() && !flags_light {

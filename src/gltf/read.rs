@@ -229,6 +229,9 @@ fn uri_path(dir: &Path, uri: &str) -> std::result::Result<PathBuf, String> {
     Ok(dir.join(decoded))
 }
 
+/// A buffer view: its buffer's bytes, its range in them, its stride.
+type View = (Rc<Vec<u8>>, std::ops::Range<usize>, Option<u64>);
+
 /// A primitive's vertices and triangles as its file gives them (before any node's transform).
 struct Primitive {
     positions: Vec<Vec3>,
@@ -397,7 +400,8 @@ impl Reader<'_> {
             .ok_or_else(|| self.err(node, format!("light {index} does not exist")))?;
         let colour = light.color.map(|c| c as f64);
         let intensity = light.intensity as f64;
-        if !colour.iter().all(|c| c.is_finite() && *c >= 0.0) || !(intensity.is_finite() && intensity >= 0.0) {
+        let finite = colour.iter().all(|c| c.is_finite() && *c >= 0.0) && intensity.is_finite() && intensity >= 0.0;
+        if !finite {
             return Err(self.err(&path, "color and intensity must be finite and not negative"));
         }
         let power = Vec3::from(colour.map(|c| (c * intensity) as f32));
@@ -709,7 +713,7 @@ impl Reader<'_> {
 
     /// A buffer view: its buffer's bytes, the view's range in them (checked against the buffer)
     /// and its stride.
-    fn view(&mut self, v: usize, from: &str) -> Result<(Rc<Vec<u8>>, std::ops::Range<usize>, Option<u64>)> {
+    fn view(&mut self, v: usize, from: &str) -> Result<View> {
         let path = format!("bufferViews[{v}]");
         let view =
             self.root.buffer_views.get(v).ok_or_else(|| self.err(from, format!("buffer view {v} does not exist")))?;
