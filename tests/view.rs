@@ -510,6 +510,64 @@ Shape "trianglemesh" "integer indices" [ 0 2 1 0 3 2 ] "point3 P" [ -4 0 -4 4 0 
     assert!(a == b, "the viewer's screenshot differs from render's image");
 }
 
+/// `view SCENE.glb` reads a glTF scene as `render` does: the window takes the size its camera's
+/// aspect ratio gives (4:3 at `--height 90`), and its screenshot equals `render SCENE.glb` (a
+/// translucent box under a directional light, seen by the file's camera).
+#[test]
+fn a_gltf_scene_in_the_viewer_equals_its_render() {
+    if !have_xvfb() {
+        return;
+    }
+    let dir = output_dir().join("view-gltf");
+    std::fs::create_dir_all(&dir).unwrap();
+    let cube = translucent::mesh::Mesh::slab(0.05, 0.05, 0.05);
+    let mut bin: Vec<u8> = cube.positions.iter().flat_map(|p| p.to_array()).flat_map(f32::to_le_bytes).collect();
+    let positions = bin.len();
+    bin.extend(cube.indices.iter().flat_map(|i| i.to_le_bytes()));
+    let json = serde_json::json!({
+        "asset": {"version": "2.0"}, "scenes": [{"nodes": [0, 1, 2]}],
+        "nodes": [{"mesh": 0, "rotation": [0.0, 0.3826834, 0.0, 0.9238795]},
+                  {"camera": 0, "translation": [0.0, 0.06, 0.2], "rotation": [-0.1478094, 0.0, 0.0, 0.9890159]},
+                  {"rotation": [-0.5, 0.0, 0.0, 0.8660254], "extensions": {"KHR_lights_punctual": {"light": 0}}}],
+        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.6, "aspectRatio": 1.3333334, "znear": 0.01}}],
+        "extensions": {"KHR_lights_punctual": {"lights": [{"type": "directional", "intensity": 2.0}]}},
+        "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.6, 0.4, 1.0]},
+                       "extensions": {"KHR_materials_volume": {"attenuationDistance": 0.002},
+                                      "KHR_materials_transmission": {"transmissionFactor": 1.0}}}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}]}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "type": "VEC3", "count": cube.positions.len(),
+                       "min": [-0.025, -0.025, -0.025], "max": [0.025, 0.025, 0.025]},
+                      {"bufferView": 1, "componentType": 5125, "type": "SCALAR", "count": cube.indices.len()}],
+        "bufferViews": [{"buffer": 0, "byteLength": positions}, {"buffer": 0, "byteOffset": positions, "byteLength": bin.len() - positions}],
+        "buffers": [{"byteLength": bin.len(), "uri": "box.bin"}]
+    });
+    std::fs::write(dir.join("box.bin"), &bin).unwrap();
+    let path = dir.join("box.gltf");
+    std::fs::write(&path, serde_json::to_vec(&json).unwrap()).unwrap();
+    let (shot, rendered) = (png("gltf-file"), png("gltf-file-render"));
+    let line = format!("screenshot {}", shot.display());
+    let args = [path.to_str().unwrap(), "--height", "90", "--samples", "4096", "--exposure", "0", "--no-panel"];
+    assert_ok("gltf-file", &view("gltf-file", &args, &["frames 1", &line, "quit"]));
+    let out = translucent(&[
+        "render",
+        "--validation",
+        path.to_str().unwrap(),
+        "--height",
+        "90",
+        "--samples",
+        "4096",
+        "--exposure",
+        "0",
+        "--out",
+        rendered.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let (a, b) = (load(&shot), load(&rendered));
+    assert_eq!((a.width(), a.height()), (120, 90), "the window takes the camera's aspect ratio");
+    assert!(a.pixels().filter(|p| p[3] > 0).count() > 500, "the box is in view");
+    assert!(a == b, "the viewer's screenshot differs from render's image");
+}
+
 /// The environment and the lights are edited from a script as the panel edits them (issue #28):
 /// a sky set, scaled, turned and sampled, a point light added and the first light moved give the
 /// image `render` gives with the same flags.

@@ -300,8 +300,9 @@ pub fn render_settings(
             let material = material_of(&shown.to_string(), desc, preset, mm_per_unit, args, given)?;
             let mut object = crate::world::Object::new(mesh, material);
             object.samples = args.samples;
-            // The texture, carried for the shading to use per point (the material is its mean's).
-            if let (false, None, Some(t)) = (given("--material"), preset, &desc.texture) {
+            // The texture, carried for the shading to use per point (the material is its mean's);
+            // not where a preset or KHR_materials_volume_scatter's colour gives the reflectance.
+            if let (false, None, None, Some(t)) = (given("--material"), preset, desc.multiscatter, &desc.texture) {
                 object.texture = Some(crate::world::Reflectance::Image(t.clone()));
                 object.uvs = uvs;
             }
