@@ -468,6 +468,13 @@ fn strips_fans_and_several_primitives() {
     let scene = tg::load(&doc.write_embedded(&d, "p"), None).unwrap();
     let tris: Vec<Vec<u32>> = scene.objects.iter().map(|o| o.mesh.indices.clone()).collect();
     assert_eq!(tris, vec![vec![0, 1, 3, 1, 2, 3], vec![1, 2, 0, 2, 3, 0], vec![0, 1, 2]]);
+    // A sparse accessor: the list's third vertex replaced by (0, 2, 0).
+    let idx = doc.view(&[2u8, 0, 0, 0], None);
+    let val = doc.view(&[0.0f32, 2.0, 0.0].map(f32::to_le_bytes).concat(), None);
+    doc.json["accessors"][list]["sparse"] =
+        json!({"count": 1, "indices": {"bufferView": idx, "componentType": 5121}, "values": {"bufferView": val}});
+    let sparse = tg::load(&doc.write_external(&d, "sparse"), None).unwrap();
+    assert_eq!(sparse.objects[2].mesh.positions, vec![Vec3::ZERO, Vec3::X, Vec3::new(0.0, 2.0, 0.0)]);
     // Every one counter-clockwise seen from +z.
     for o in &scene.objects {
         for t in o.mesh.indices.chunks(3) {
@@ -593,6 +600,56 @@ fn glb_external_and_embedded_buffers_give_the_same_world_and_image() {
     assert_eq!(ia.dimensions(), (48, 32));
     assert!(ia == ib, "GLB and .gltf render differently");
     assert!(ia.pixels().filter(|p| p[3] > 0.0).count() > 200, "the box and the floor are in view");
+}
+
+/// Flags typed on the command line override the file: the camera's parts, its aspect ratio's
+/// size, the lights, the scale, the roughness.
+#[test]
+fn flags_override_the_file() {
+    let d = dir("flags");
+    let png = png_bytes(2, 2, |_, _| [200, 200, 200]);
+    std::fs::write(d.join("grey.png"), &png).unwrap();
+    let mut doc = Doc::new();
+    doc.json["images"] = json!([{"uri": "grey.png"}]);
+    doc.json["textures"] = json!([{"source": 0}]);
+    box_scene(&mut doc, json!({"index": 0}));
+    let path = doc.write_external(&d, "box");
+    let (args, file) = full_settings(&path, &["--width", "300"]).unwrap();
+    assert_eq!((args.width, args.height), (300, 200), "--width typed: the height from the aspect ratio 1.5");
+    assert!((file.desc.camera.fov_y_deg - 0.6f32.to_degrees()).abs() < 1e-4);
+    let typed = [
+        "--eye",
+        "1,2,3",
+        "--target",
+        "0,0.1,0",
+        "--up",
+        "0,0,1",
+        "--fov",
+        "25",
+        "--light",
+        "dir:0,1,0:2",
+        "--scale",
+        "100",
+        "--roughness",
+        "0.8",
+        "--width",
+        "40",
+        "--height",
+        "40",
+    ];
+    let (args, s) = full_settings(&path, &typed).unwrap();
+    assert_eq!((args.width, args.height), (40, 40));
+    let c = &s.desc.camera;
+    let f = 100.0 / s.world.mm_per_unit; // positions × the power-of-two rescale
+    assert_eq!(
+        (c.eye / f, c.target / f, c.up, c.fov_y_deg),
+        (Vec3::new(1.0, 2.0, 3.0), Vec3::new(0.0, 0.1, 0.0), Vec3::Z, 25.0)
+    );
+    assert_eq!(s.desc.lights, vec![Light::Directional { toward: Vec3::Y, irradiance: Vec3::splat(2.0) }]);
+    assert_eq!((s.desc.roughness, s.world.mm_per_unit * f), (0.8, 100.0));
+    // An environment typed replaces the file's lights.
+    let s = settings_of(&path, &["--env", "const:0.5", "--env-samples", "4"]).unwrap();
+    assert!(s.desc.environment.is_some() && s.desc.lights.iter().all(|l| matches!(l, Light::Directional { .. })));
 }
 
 /// A translucent material's base colour texture: carried on the object (texels × factor, uvs
@@ -1009,6 +1066,31 @@ fn every_refusal_names_the_file_and_the_json_path() {
     );
 }
 
+fn count_numbers(v: &Value) -> usize {
+    match v {
+        Value::Number(_) => 1,
+        Value::Array(a) => a.iter().map(count_numbers).sum(),
+        Value::Object(o) => o.values().map(count_numbers).sum(),
+        _ => 0,
+    }
+}
+
+/// The `n`th number of a JSON tree, depth first.
+fn nth_number<'a>(v: &'a mut Value, n: &mut usize) -> Option<&'a mut Value> {
+    if v.is_number() {
+        if *n == 0 {
+            return Some(v);
+        }
+        *n -= 1;
+        return None;
+    }
+    match v {
+        Value::Array(a) => a.iter_mut().find_map(|x| nth_number(x, n)),
+        Value::Object(o) => o.values_mut().find_map(|x| nth_number(x, n)),
+        _ => None,
+    }
+}
+
 /// The reference decoder: the spec's rules written out element by element.
 fn reference(view: &[u8], l: &Layout) -> Option<Vec<f32>> {
     let size = l.component.size() as u64;
@@ -1107,7 +1189,30 @@ proptest! {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 200, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 1000, ..ProptestConfig::default() })]
+
+    /// The whole reader on a valid file with numbers of its JSON changed (counts, offsets,
+    /// strides, indices, factors) to values a file may hold: a result or a refusal, never a panic.
+    #[test]
+    fn the_reader_never_panics_on_changed_numbers(edits in proptest::collection::vec((any::<prop::sample::Index>(), prop_oneof![
+        Just(json!(0)), Just(json!(1)), Just(json!(-1)), Just(json!(3)), Just(json!(4)), Just(json!(255)), Just(json!(5121)),
+        Just(json!(5126)), Just(json!(4294967295u64)), Just(json!(1u64 << 40)), Just(json!(1e30)), Just(json!(-1e30)),
+        Just(json!(0.5)), Just(json!(1e-30)), Just(json!(18446744073709551615u64)), Just(json!("VEC3")), Just(json!([]))]), 1..5)) {
+        let d = dir("numbers");
+        let mut doc = triangle();
+        box_scene(&mut doc, json!({"index": 0}));
+        doc.json["images"] = json!([{"uri": "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAIAAACQd1PeAAAADElEQVR4nGP4//8/AAX+Av4N70a4AAAAAElFTkSuQmCC"}]);
+        doc.json["textures"] = json!([{"source": 0}]);
+        for (at, new) in edits {
+            let count = count_numbers(&doc.json);
+            if let Some(v) = nth_number(&mut doc.json, &mut at.index(count)) {
+                *v = new;
+            }
+        }
+        let path = doc.write_glb(&d, "n");
+        let _ = tg::load(&path, None);
+        let _ = settings_of(&path, &[]);
+    }
 
     /// The whole reader on a valid file with bytes changed: a result or a refusal, never a panic.
     #[test]

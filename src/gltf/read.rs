@@ -71,6 +71,20 @@ pub fn load(path: &Path, scene: Option<usize>) -> Result<GltfScene> {
             ));
         }
     }
+    // The crate's validation indexes the accessors by POSITION without a check (gltf-json
+    // 1.4.1, mesh.rs): an index out of range is refused here first.
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            let position = prim.attributes.get(&Checked::Valid(json::mesh::Semantic::Positions));
+            if let Some(a) = position.filter(|a| a.value() >= root.accessors.len()) {
+                return Err(bad_input!(
+                    "{shown}: meshes[{m}].primitives[{p}].attributes.POSITION: accessor {} does not exist ({} accessors)",
+                    a.value(),
+                    root.accessors.len()
+                ));
+            }
+        }
+    }
     // Draco-compressed primitives whose accessors have no data of their own (the crate's
     // validation would call them a missing bufferView): refused by name.
     for (m, mesh) in root.meshes.iter().enumerate() {
