@@ -116,9 +116,8 @@ impl MaterialDesc {
     /// KHR_materials_volume with a thickness or an attenuation, and a transmission (specular or
     /// diffuse) above 0.
     pub fn is_translucent(&self) -> bool {
-        let volume = self.volume.as_ref().is_some_and(|v| {
-            v.thickness > 0.0 || v.attenuation_distance.is_finite() || v.attenuation_color != [1.0; 3]
-        });
+        // A colour without a distance attenuates nothing (the distance's default is infinite).
+        let volume = self.volume.as_ref().is_some_and(|v| v.thickness > 0.0 || v.attenuation_distance.is_finite());
         let transmits =
             self.transmission.is_some_and(|t| t > 0.0) || self.diffuse_transmission.is_some_and(|t| t > 0.0);
         volume && transmits
@@ -288,6 +287,7 @@ pub fn render_settings(
     let mut opaque = Vec::new();
     let mut first_translucent: Option<&MaterialDesc> = None;
     let mut translucent_paths = Vec::new();
+    let mut made = std::collections::HashMap::new();
     for o in &scene.objects {
         let desc = &scene.materials[o.material];
         let shown_object = format!("{shown}: {}", o.path);
@@ -297,7 +297,15 @@ pub fn render_settings(
             first_translucent.get_or_insert(desc);
             translucent_paths.push(&o.path);
             let preset = preset_of(desc);
-            let material = material_of(&shown.to_string(), desc, preset, mm_per_unit, args, given)?;
+            // Once per material (its warnings too), however many primitives use it.
+            let material = match made.get(&o.material) {
+                Some(m) => Clone::clone(m),
+                None => {
+                    let m = material_of(&shown.to_string(), desc, preset, mm_per_unit, args, given)?;
+                    made.insert(o.material, m.clone());
+                    m
+                }
+            };
             let mut object = crate::world::Object::new(mesh, material);
             object.samples = args.samples;
             // The texture, carried for the shading to use per point (the material is its mean's);

@@ -215,8 +215,8 @@ fn data_uri(uri: &str, cap: u64) -> Option<std::result::Result<Vec<u8>, String>>
     Some(engine.decode(data.trim_end()).map_err(|e| format!("not base64: {e}")))
 }
 
-/// A relative URI as a path beside the glTF file: percent-decoded; absolute URIs (a scheme,
-/// a leading '/') refused.
+/// A URI reference as a path: percent-decoded, relative to the glTF file's folder (or absolute);
+/// a URI with a scheme (`http:`, `file:`, …) other than `data:` is refused.
 fn uri_path(dir: &Path, uri: &str) -> std::result::Result<PathBuf, String> {
     let scheme = uri
         .split_once(':')
