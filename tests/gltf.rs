@@ -307,7 +307,7 @@ fn the_default_bunny_written_as_gltf_renders_as_the_flags_do() {
     );
     // Measured: 3345 of 12288 channels differ, worst 1.04e-4 relative, total 2.2e-6 of the image:
     // the camera's axis from the quaternion is the framing's within 1e-7 (f32 rounding), which
-    // moves the hierarchy's sample points by as much; no pixel changes coverage.
+    // moves where each pixel meets the surface by as much; no pixel changes coverage.
     assert!(coverage == 0 && worst < 1e-3 && sum / mean < 2e-5, "the camera node's image is not the framing's");
 }
 
