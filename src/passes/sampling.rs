@@ -1,8 +1,10 @@
 //! Surface sampling: the triangle-area prefix sum (64-bit fixed point), then N points uniform by area.
-//! Reads: vertices, indices. Writes: area prefix sum, points (unsorted).
+//! Reads: vertices, indices, the object's texture (its scatter weight, at each point's uv).
+//! Writes: area prefix sum, points (unsorted).
 
 use crate::error::Result;
 use crate::gpu::SampleConstants;
+use crate::gpu_world::SurfaceTexture;
 use crate::vk::{Bind, Buffer, Context, Pipeline, Recorder};
 
 /// Bytes of the triangle-area prefix sum for `triangles` triangles: the total area (f32 and
@@ -30,6 +32,7 @@ impl SamplingPass {
         rec: &mut Recorder,
         vertices: &Buffer,
         indices: &Buffer,
+        texture: &SurfaceTexture,
         triangle_count: u32,
         prefix: &Buffer,
         points: &Buffer,
@@ -56,10 +59,24 @@ impl SamplingPass {
             bytemuck::bytes_of(&[triangle_count, point_count]),
             [1, 1, 1],
         )?;
-        let constants = SampleConstants { point_count, triangle_count, seed };
+        let constants = SampleConstants {
+            point_count,
+            triangle_count,
+            seed,
+            texture_kind: texture.kind,
+            tex1: texture.tex1,
+            tex2: texture.tex2,
+        };
         rec.dispatch(
             &self.points,
-            &[Bind::Read(vertices), Bind::Read(indices), Bind::Read(prefix), Bind::Write(points)],
+            &[
+                Bind::Read(vertices),
+                Bind::Read(indices),
+                Bind::Read(prefix),
+                Bind::Write(points),
+                Bind::Read(&texture.uvs),
+                Bind::Sampled(&texture.image, &texture.sampler),
+            ],
             bytemuck::bytes_of(&constants),
             [point_count.div_ceil(64), 1, 1],
         )
