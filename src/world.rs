@@ -85,6 +85,22 @@ pub enum Reflectance {
     Image(Texture),
 }
 
+impl Reflectance {
+    /// The mean over the surface's uv square: a checkerboard's two values equally, an image's
+    /// texels (summed in f64).
+    pub fn mean(&self) -> Vec3 {
+        match self {
+            Reflectance::Constant(c) => *c,
+            Reflectance::Checkerboard { tex1, tex2, .. } => (*tex1 + *tex2) * 0.5,
+            Reflectance::Image(t) => {
+                let sum = t.texels.iter().fold([0.0f64; 3], |s, p| [0, 1, 2].map(|c| s[c] + p[c] as f64));
+                let n = t.texels.len().max(1) as f64;
+                Vec3::new((sum[0] / n) as f32, (sum[1] / n) as f32, (sum[2] / n) as f32)
+            }
+        }
+    }
+}
+
 /// An image of linear reflectances, rows from the top.
 #[derive(Clone, Debug)]
 pub struct Texture {

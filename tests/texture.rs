@@ -134,3 +134,66 @@ fn each_half_of_a_two_colour_slab_reflects_its_colour() {
         assert!(profile.windows(2).all(|w| w[1].x <= w[0].x * 1.001), "red falls monotonically: {profile:?}");
     }
 }
+
+/// pbrt-v4's `subsurface` with `"texture reflectance"` (a checkerboard over the shape's uv): each
+/// half of the slab takes its colour; without uv the shape is refused, naming it.
+#[test]
+fn pbrt_subsurface_with_a_reflectance_texture() {
+    let dir = common::output_dir().join("texture-pbrt");
+    std::fs::create_dir_all(&dir).unwrap();
+    // A box 100 x 20 x 100 mm, u running 0 → 2 along x.
+    let (h, t) = (50.0, 10.0);
+    let mut p = Vec::new();
+    let mut uv = Vec::new();
+    for k in 0..8 {
+        let (x, y, z) =
+            (if k & 1 == 0 { -h } else { h }, if k & 2 == 0 { -t } else { t }, if k & 4 == 0 { -h } else { h });
+        p.extend([x, y, z]);
+        uv.extend([(x / (2.0 * h) + 0.5) * 1.9999, 0.0]);
+    }
+    // Counter-clockwise seen from outside.
+    let faces = [[0, 4, 6, 2], [1, 3, 7, 5], [0, 1, 5, 4], [2, 6, 7, 3], [0, 2, 3, 1], [4, 5, 7, 6]];
+    let indices: Vec<u32> = faces.iter().flat_map(|f| [f[0], f[1], f[2], f[0], f[2], f[3]]).collect();
+    let list = |v: &[f64]| v.iter().map(|x| format!("{x}")).collect::<Vec<_>>().join(" ");
+    let ilist = indices.iter().map(|i| i.to_string()).collect::<Vec<_>>().join(" ");
+    let scene = |with_uv: bool| {
+        format!(
+            "LookAt 0 2000 0  0 0 0  0 0 -1\nCamera \"perspective\" \"float fov\" 2.6\n\
+             Film \"rgb\" \"integer xresolution\" 48 \"integer yresolution\" 48\nWorldBegin\n\
+             LightSource \"distant\" \"point3 from\" [0 1 0] \"point3 to\" [0 0 0]\n\
+             Texture \"colours\" \"spectrum\" \"checkerboard\" \"float uscale\" 1 \"float vscale\" 0 \"rgb tex1\" [0.62 0.42 0.30] \"rgb tex2\" [0.25 0.12 0.06]\n\
+             Material \"subsurface\" \"texture reflectance\" \"colours\" \"rgb mfp\" [1.3 1.1 0.9]\n\
+             Shape \"trianglemesh\" \"point3 P\" [{}] {} \"integer indices\" [{ilist}]\n",
+            list(&p),
+            if with_uv { format!("\"point2 uv\" [{}]", list(&uv)) } else { String::new() }
+        )
+    };
+    let path = dir.join("slab.pbrt");
+    std::fs::write(&path, scene(true)).unwrap();
+    let out = dir.join("slab.exr");
+    // The classical dipole: its total reflectance is the one the texture states.
+    let o = common::translucent(&[
+        "render",
+        path.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--no-specular",
+        "--model",
+        "dipole",
+    ]);
+    assert!(o.status.success(), "{}", common::stderr(&o));
+    let image = image::open(&out).unwrap().into_rgba32f();
+    let at = |x: u32| image.get_pixel(x, 24).0;
+    // pbrt's camera mirrors x: u = 0 (tex1) lies on the image's right.
+    let (a, b) = (at(8), at(40));
+    let (bright, dark) = if a[0] > b[0] { (a, b) } else { (b, a) };
+    for c in 0..3 {
+        let ratio = bright[c] / dark[c];
+        let expected = [0.62 / 0.25, 0.42 / 0.12, 0.30 / 0.06][c];
+        assert!((ratio / expected - 1.0).abs() < 0.05, "channel {c}: {ratio} against {expected}: {bright:?} {dark:?}");
+    }
+    std::fs::write(&path, scene(false)).unwrap();
+    let o = common::translucent(&["render", path.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", common::stderr(&o));
+    assert!(common::stderr(&o).contains("needs the shape's \"point2 uv\""), "{}", common::stderr(&o));
+}
