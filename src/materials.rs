@@ -351,7 +351,7 @@ fn total_at(curve: &[(f64, f64)], rho: f64) -> f64 {
 /// lengths (midpoint rule in ln r; 400 nodes hold it to 1e-4).
 fn directional_total(c: &crate::physics::ChannelConstants) -> f64 {
     use glam::DVec3;
-    if !c.transports || !(c.sigma_tr > 0.0) {
+    if !c.transports || c.sigma_tr.is_nan() || c.sigma_tr <= 0.0 {
         return 0.0;
     }
     let (lo, hi) = (1e-6f64.ln(), (40.0 / c.sigma_tr).ln());
