@@ -44,7 +44,11 @@ impl SamplingPass {
         // run on lavapipe (see README "Validation").
         let n = point_count as u64;
         let t = triangle_count as u64;
-        for (buffer, needed) in [(indices, t * 12), (prefix, prefix_bytes(triangle_count)), (points, n * 64)] {
+        // A texture reads one uv (8 bytes) per vertex (24 bytes each).
+        let uv_bytes = if texture.kind != 0 { vertices.size / 24 * 8 } else { 0 };
+        let needs =
+            [(indices, t * 12), (prefix, prefix_bytes(triangle_count)), (points, n * 64), (&texture.uvs, uv_bytes)];
+        for (buffer, needed) in needs {
             if buffer.size < needed {
                 return Err(crate::runtime!(
                     "sampling: {} holds {} bytes; {triangle_count} triangles and {point_count} points need {needed}",
