@@ -178,6 +178,23 @@ impl Material {
         })
     }
 
+    /// This material with the total diffuse reflectance `rho` per channel (each below the
+    /// classical dipole's Rd at albedo 1, else held just under it) and the same mean free path,
+    /// g and η: the inversion of [`crate::pbrt::from_reflectance`], per channel.
+    pub fn with_reflectance(&self, rho: [f64; 3]) -> Result<Material> {
+        let top = crate::pbrt::max_reflectance(self.eta) * 0.999;
+        let mut m = self.clone();
+        for ch in 0..3 {
+            let c = self.channel(ch).constants(Diffusion::Classical);
+            let mfp = [1.0 / c.sigma_t_reduced.max(MIN_SIGMA); 3];
+            let (a, s) = crate::pbrt::from_reflectance([rho[ch].clamp(0.0, top); 3], mfp, self.g[ch], self.eta)
+                .map_err(|why| bad_input!("{}: {why}", self.name))?;
+            (m.sigma_a[ch], m.sigma_s[ch]) = (a[ch], s[ch]);
+        }
+        m.validate()?;
+        Ok(m)
+    }
+
     pub fn channel(&self, ch: usize) -> Medium {
         Medium { sigma_a: self.sigma_a[ch], sigma_s: self.sigma_s[ch], g: self.g[ch], eta: self.eta }
     }

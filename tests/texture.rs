@@ -197,3 +197,108 @@ fn pbrt_subsurface_with_a_reflectance_texture() {
     assert_eq!(o.status.code(), Some(2), "{}", common::stderr(&o));
     assert!(common::stderr(&o).contains("needs the shape's \"point2 uv\""), "{}", common::stderr(&o));
 }
+
+/// An OBJ file's `map_Kd` (through its `mtllib`) colours it as a pbrt texture does: a box whose
+/// map is bright over u < 1/2 and dark over u > 1/2 (an sRGB PNG), renders its halves
+/// in the ratio of their colours (the classical dipole); a map that is missing, or a mesh without
+/// `vt`, exits 2 naming it.
+#[test]
+fn obj_map_kd_colours_a_translucent_mesh() {
+    let dir = common::output_dir().join("texture-obj");
+    std::fs::create_dir_all(&dir).unwrap();
+    let (h, t) = (50.0f32, 10.0f32);
+    let mut obj = String::from("mtllib box.mtl\nusemtl painted\n");
+    let mut obj_no_vt = String::from("mtllib box.mtl\nusemtl painted\n");
+    for k in 0..8 {
+        let (x, y, z) =
+            (if k & 1 == 0 { -h } else { h }, if k & 2 == 0 { -t } else { t }, if k & 4 == 0 { -h } else { h });
+        obj += &format!("v {x} {y} {z}\nvt {} 0.5\n", if x < 0.0 { 0.02 } else { 0.98 });
+        obj_no_vt += &format!("v {x} {y} {z}\n");
+    }
+    for f in [[0, 4, 6, 2], [1, 3, 7, 5], [0, 1, 5, 4], [2, 6, 7, 3], [0, 2, 3, 1], [4, 5, 7, 6]] {
+        obj += &format!(
+            "f {}/{} {}/{} {}/{} {}/{}\n",
+            f[0] + 1,
+            f[0] + 1,
+            f[1] + 1,
+            f[1] + 1,
+            f[2] + 1,
+            f[2] + 1,
+            f[3] + 1,
+            f[3] + 1
+        );
+        obj_no_vt += &format!("f {} {} {} {}\n", f[0] + 1, f[1] + 1, f[2] + 1, f[3] + 1);
+    }
+    std::fs::write(dir.join("box.obj"), &obj).unwrap();
+    std::fs::write(dir.join("box-no-vt.obj"), &obj_no_vt).unwrap();
+    std::fs::write(dir.join("box.mtl"), "newmtl painted\nKd 1 1 1\nmap_Kd colours.png\n").unwrap();
+    // Linear reflectances 0.6 and 0.2, sRGB-encoded, four texels each: filtered linearly (and
+    // repeated), the map is flat over u in [1/16, 7/16] and [9/16, 15/16], 19 mm (five of Skin1's
+    // longest diffusion lengths) around the pixels measured, and the box's uv runs from 0.02 to
+    // 0.98 across it.
+    let srgb =
+        |x: f32| (255.0 * if x <= 0.0031308 { 12.92 * x } else { 1.055 * x.powf(1.0 / 2.4) - 0.055 }).round() as u8;
+    let (bright, dark) = (0.6f32, 0.2f32);
+    let png = image::RgbImage::from_fn(8, 1, |x, _| image::Rgb([srgb(if x < 4 { bright } else { dark }); 3]));
+    png.save(dir.join("colours.png")).unwrap();
+    let out = dir.join("box.exr");
+    let args = |mesh: &str| {
+        let mesh = dir.join(mesh);
+        let v: Vec<String> = [
+            "render",
+            "--mesh",
+            mesh.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--no-specular",
+            "--model",
+            "dipole",
+            "--width",
+            "48",
+            "--height",
+            "48",
+            "--eye",
+            "0,2000,0",
+            "--target",
+            "0,0,0",
+            "--up",
+            "0,0,-1",
+            "--fov",
+            "3.2",
+            "--light-dir",
+            "0,1,0",
+            "--scale",
+            "1",
+            "--samples",
+            "40000",
+            "--material",
+            "skin1",
+        ]
+        .map(String::from)
+        .to_vec();
+        v
+    };
+    let run = |mesh: &str| {
+        let a = args(mesh);
+        common::translucent(&a.iter().map(String::as_str).collect::<Vec<_>>())
+    };
+    let o = run("box.obj");
+    assert!(o.status.success(), "{}", common::stderr(&o));
+    let image = image::open(&out).unwrap().into_rgba32f();
+    // 25 mm either side of the middle: u 0.26 and 0.74 of the map.
+    let mm_per_pixel = 2.0 * 2000.0 * (3.2f32.to_radians() / 2.0).tan() / 48.0;
+    let px = |x_mm: f32| (24.0 + x_mm / mm_per_pixel) as u32;
+    let (left, right) = (image.get_pixel(px(-25.0), 24).0, image.get_pixel(px(25.0), 24).0);
+    for c in 0..3 {
+        let ratio = left[c] / right[c];
+        // 8-bit sRGB holds 0.6 and 0.2 within 0.5% and 0.8%.
+        assert!((ratio / (bright / dark) - 1.0).abs() < 0.02, "channel {c}: {ratio}: {left:?} {right:?}");
+    }
+    let o = run("box-no-vt.obj");
+    assert_eq!(o.status.code(), Some(2), "{}", common::stderr(&o));
+    assert!(common::stderr(&o).contains("texture coordinates"), "{}", common::stderr(&o));
+    std::fs::remove_file(dir.join("colours.png")).unwrap();
+    let o = run("box.obj");
+    assert_eq!(o.status.code(), Some(2), "{}", common::stderr(&o));
+    assert!(common::stderr(&o).contains("colours.png"), "{}", common::stderr(&o));
+}
