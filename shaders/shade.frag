@@ -61,6 +61,9 @@ layout(binding = 14) uniform usamplerBuffer point_flux;
 layout(binding = 15) uniform usamplerBuffer point_spread;
 // The same shadow map's depth, unfiltered: how far light travels inside (single scattering).
 layout(binding = 16) uniform sampler2DArray shadow_depth;
+// The G-buffer's texture: a translucent pixel's scatter weight (1 where the object has no
+// texture; gpu_world::SurfaceTexture).
+layout(binding = 17, rgba32f) uniform readonly image2D surface_albedo;
 vec4 dipole_header; // its texel 0, read once per pixel
 vec4 slab_header; // the Monte Carlo table's slab header (L in mm, scales), read once per pixel (0 for the other models)
 
@@ -78,6 +81,9 @@ const uint MAX_STEPS = 32768u;
 
 // The near field (see near_field()): the pixel's own irradiance and flux, merged over the lights
 // (set in main when the frame splits it off; own_lit false where the pixel is unlit).
+// The pixel's scatter weight: the points' irradiance carries theirs (the source's), the sum is
+// multiplied by the pixel's (the exit's), so a texture weighs each pair by the geometric mean.
+vec3 own_weight = vec3(1.0);
 vec3 own_irradiance;
 vec4 own_incident[3];
 bool own_lit = false;
@@ -257,8 +263,9 @@ void own_light(vec3 xo, vec3 no) {
         vec3 e = light_irradiance(light_of(k), xo, no, toward);
         if (e == vec3(0.0)) continue;
         vec4 term = flux_term(toward, no);
-        // As the irradiance pass weighs each point's (1 but for the Monte Carlo table).
-        e *= table_incidence_factor(dipole_table, term.w);
+        // As the irradiance pass weighs each point's (1 but for the Monte Carlo table, and its
+        // scatter weight).
+        e *= table_incidence_factor(dipole_table, term.w) * own_weight;
         for (uint c = 0u; c < 3u; ++c) own_incident[c] += e[c] * term;
         own_irradiance += e;
     }
@@ -564,6 +571,7 @@ void main() {
     if (surface.w != float(pc.point_range.z + 1u)) discard;
     vec3 xo = surface.xyz;
     vec3 no = normalize(imageLoad(surface_normal, pixel).xyz);
+    own_weight = imageLoad(surface_albedo, pixel).rgb;
     dipole_header = dipole_table_header(dipole_table);
     slab_header = MODEL == MODEL_MC ? slab_header_of(dipole_table) : vec4(0.0);
     vec3 wo = normalize(pc.eye.xyz - xo);
@@ -783,6 +791,9 @@ void main() {
         atomicAdd(work.objects[pc.point_range.z].evaluation_sum, evaluations);
     }
     float cos_o = max(dot(no, wo), 0.0);
+    // The exit's half of the texture's weight (the sources' half is in their irradiance).
+    sum *= own_weight;
+    across_sum *= own_weight;
     vec3 lo = fresnel_transmittance(object_params.channels[0].eta, cos_o) * sum;
     // The Monte Carlo table's exit distribution (the others' lobe is Ft alone).
     if (MODEL == MODEL_MC) {
@@ -797,7 +808,8 @@ void main() {
             lo += fresnel_transmittance(object_params.channels[0].eta, cos_o) * across_sum;
         }
         // Single scattering, once (by the first of several brute-force draws, as the lobe).
-        if (pc.point_range.x == 0u) lo += single_scattering(xo, no, wo);
+        // Single scattering is the pixel's own: its whole weight (the albedo's ratio).
+        if (pc.point_range.x == 0u) lo += own_weight * own_weight * single_scattering(xo, no, wo);
     }
     // The lobe is added once: by the first of several brute-force draws.
     if (frame_params.specular != 0u && pc.point_range.x == 0u) lo += specular(xo, no, wo);

@@ -11,7 +11,7 @@ use crate::error::Result;
 use crate::frame_desc::{FrameDesc, Show};
 use crate::gpu::sd_table::AngularFactors;
 use crate::gpu::{DebugConstants, FrameParams, ShadeConstants, WorkCounters};
-use crate::gpu_world::{GpuObject, GpuWorld};
+use crate::gpu_world::{GpuObject, GpuWorld, SurfaceTexture};
 use crate::hierarchy::Hierarchy;
 use crate::output::{self, Exposure, HdrImage};
 use crate::passes::background::BackgroundPass;
@@ -19,7 +19,7 @@ use crate::passes::debug_view::{self, DebugViewPass};
 use crate::passes::diffuse::DiffusePass;
 use crate::passes::irradiance::IrradiancePass;
 use crate::passes::sampling::SamplingPass;
-use crate::passes::shade::{self, OpaqueDraw, ShadeInputs, ShadePass};
+use crate::passes::shade::{self, ShadeInputs, ShadePass, SurfaceDraw};
 use crate::passes::shadow::ShadowPass;
 use crate::passes::sort::SortPass;
 use crate::passes::tile_cut::{TileCutPass, TileLists};
@@ -403,6 +403,8 @@ pub struct HierarchyPasses {
     /// An Sd table buffer with no angular factors (all 1): what [`HierarchyPasses::record`]'s
     /// irradiance reads for a hierarchy without an object.
     no_factors: Buffer,
+    /// No texture (a scatter weight of 1 everywhere), for the same.
+    no_texture: SurfaceTexture,
 }
 
 impl HierarchyPasses {
@@ -418,6 +420,7 @@ impl HierarchyPasses {
         no_factors.write((table_texels * 16) as u64, &AngularFactors::none().texels())?;
         Ok(HierarchyPasses {
             no_factors,
+            no_texture: SurfaceTexture::new(ctx, &crate::world::Reflectance::Constant(glam::Vec3::ONE), None, 1)?,
             sampling: SamplingPass::new(ctx)?,
             shadow: ShadowPass::new(ctx)?,
             irradiance: IrradiancePass::new(ctx)?,
@@ -429,7 +432,8 @@ impl HierarchyPasses {
     /// The frame's first seven passes: `h` rebuilt from the mesh in `vertices` and `indices`,
     /// alone in the world. Tests and tools record them so to build a hierarchy.
     pub fn record(&self, rec: &mut Recorder, h: &Hierarchy, vertices: &Buffer, indices: &Buffer) -> Result<()> {
-        self.record_among(rec, h, vertices, indices, &self.no_factors, &[(vertices, indices, h.index_count)])
+        let casters = [(vertices, indices, h.index_count)];
+        self.record_among(rec, h, (vertices, indices), &self.no_texture, &self.no_factors, &casters)
     }
 
     /// Every mesh of `casters` into the maps of `shadows`.
@@ -443,13 +447,14 @@ impl HierarchyPasses {
     }
 
     /// The same among other objects: `casters` (every object's mesh, this one's included) cast
-    /// the shadows its irradiance sees; `sd_table` is the object's (its angular factors).
+    /// the shadows its irradiance sees; `texture` is its scatter weight and `sd_table` its Sd
+    /// table (their angular factors).
     pub fn record_among(
         &self,
         rec: &mut Recorder,
         h: &Hierarchy,
-        vertices: &Buffer,
-        indices: &Buffer,
+        (vertices, indices): (&Buffer, &Buffer),
+        texture: &SurfaceTexture,
         sd_table: &Buffer,
         casters: &[(&Buffer, &Buffer, u32)],
     ) -> Result<()> {
@@ -457,7 +462,7 @@ impl HierarchyPasses {
         let (sort, tree) = (h.sort_buffers(), h.tree_buffers());
         // N points uniform by area over the mesh.
         rec.scope("sampling", |rec| {
-            self.sampling.record(rec, vertices, indices, h.triangle_count, &h.prefix, &h.points, n, h.seed)
+            self.sampling.record(rec, vertices, indices, texture, h.triangle_count, &h.prefix, &h.points, n, h.seed)
         })?;
         // Depth of every object from each light, into the layers of one shadow map.
         let shadows = &h.shadows;
@@ -543,15 +548,18 @@ impl Renderer {
         let casters: Vec<_> =
             w.objects.iter().map(|o| (&o.vertices, &o.indices, o.index_count)).chain(opaque_meshes).collect();
         let inputs: Vec<ShadeInputs> = (0..objects).map(|k| shade_inputs!(self, k)).collect();
-        // Opaque objects' G-buffer ids follow the translucent ones'.
-        let opaque: Vec<OpaqueDraw> = (w.opaque.iter().enumerate())
-            .map(|(j, o)| OpaqueDraw {
-                vertices: &o.vertices,
-                indices: &o.indices,
-                index_count: o.index_count,
-                uvs: &o.uvs,
-                texture: (&o.texture, &o.sampler),
-                constants: o.surface_constants(view_projection, (objects + j) as u32),
+        // Every object's draw into the G-buffer: the translucent ones (ids from 0), then the
+        // opaque ones.
+        let translucent_meshes = w.objects.iter().map(|o| (&o.vertices, &o.indices, o.index_count, &o.texture));
+        let opaque_surfaces = w.opaque.iter().map(|o| (&o.vertices, &o.indices, o.index_count, &o.texture));
+        let surfaces: Vec<SurfaceDraw> = (translucent_meshes.chain(opaque_surfaces).enumerate())
+            .map(|(id, (vertices, indices, index_count, texture))| SurfaceDraw {
+                vertices,
+                indices,
+                index_count,
+                uvs: &texture.uvs,
+                texture: (&texture.image, &texture.sampler),
+                constants: texture.surface_constants(view_projection, id as u32),
             })
             .collect();
         if let Some(p) = self.profiler.as_mut() {
@@ -564,8 +572,8 @@ impl Renderer {
                 self.passes.hierarchy.record_among(
                     rec,
                     &o.hierarchy,
-                    &o.vertices,
-                    &o.indices,
+                    (&o.vertices, &o.indices),
+                    &o.texture,
                     &o.sd_table,
                     &casters,
                 )?;
@@ -585,7 +593,7 @@ impl Renderer {
                 albedo: &t.albedo,
                 work: &self.work_counters,
             };
-            rec.scope("surface", |rec| self.passes.shade.record_surface(rec, &targets, &inputs, &opaque, &constants))?;
+            rec.scope("surface", |rec| self.passes.shade.record_surface(rec, &targets, &surfaces))?;
             // What no surface covers: the environment, or black.
             let aspect = desc.width as f32 / desc.height as f32;
             let t = &self.targets;
@@ -612,7 +620,7 @@ impl Renderer {
             }
             Ok(())
         })?;
-        drop((inputs, opaque));
+        drop((inputs, surfaces));
         for k in 0..objects {
             if !cut {
                 break;

@@ -3,16 +3,16 @@
 //! to make again when the world or the frame's lights change; the renderer calls it when a frame
 //! begins, never while one is in flight.
 
-use glam::Vec3;
+use glam::{Vec2, Vec3, Vec4};
 
 use crate::bad_input;
 use crate::budget::{self, FrameSizes};
 use crate::error::Result;
 use crate::frame_desc::FrameDesc;
 use crate::gpu::sd_table::{AngularFactors, SlabTransmission};
-use crate::gpu::{DiffuseSurfaceConstants, GpuChannel, ObjectParams, SdTable};
+use crate::gpu::{GpuChannel, ObjectParams, SdTable, SurfaceConstants};
 use crate::hierarchy::{self, Hierarchy, HierarchyOptions};
-use crate::materials::Material;
+use crate::materials::{Material, ScatterWeight};
 use crate::mesh::Mesh;
 use crate::physics::beam_diffusion::BeamMedium;
 use crate::physics::mc_profile::McProfile;
@@ -23,7 +23,7 @@ use crate::shadows::Shadows;
 use crate::vk::{
     self, Buffer, BufferUsageFlags, Context, Extent2D, Format, Image, ImageUsageFlags, MemoryLocation, Sampler,
 };
-use crate::world::{Opaque, Reflectance, World};
+use crate::world::{Object, Opaque, Reflectance, Texture, World};
 
 /// One object on the GPU.
 pub struct GpuObject {
@@ -38,6 +38,8 @@ pub struct GpuObject {
     /// The Sd table (texels) of the material for the frame's model: photon beam diffusion's for
     /// `pbd`, else the classical dipole's (the directional dipole reads none).
     pub sd_table: Buffer,
+    /// Its texture's scatter weight (1 everywhere without one).
+    pub texture: SurfaceTexture,
     /// What the buffers above were made from.
     made_from: MadeFrom,
 }
@@ -52,6 +54,11 @@ struct MadeFrom {
     mm_per_unit: f32,
     /// The sample count asked for (`None`: the default), and the count it resolved to.
     samples: Option<u32>,
+    /// The texture and its uvs (the scatter weight is made from them, the material and the
+    /// model with its diffusion).
+    texture: Option<Reflectance>,
+    uvs: Option<Vec<Vec2>>,
+    weight_model: (Model, Diffusion),
 }
 
 /// The radial profile an object's Sd table holds.
@@ -72,17 +79,109 @@ impl TableProfile {
     }
 }
 
+/// An object's texture on the GPU (shaders/include/surface_texture.glsl): one uv per vertex, an
+/// image (one white texel unless the texture is an image) with its repeating sampler, and how to
+/// read them. Opaque objects hold their Lambertian reflectance in it, translucent ones their
+/// scatter weight ([`ScatterWeight`]).
+pub struct SurfaceTexture {
+    pub uvs: Buffer,
+    pub image: Image,
+    pub sampler: Sampler,
+    /// surface_texture.glsl's kind, and its two values (with a checkerboard's scales in w).
+    pub kind: u32,
+    pub tex1: Vec4,
+    pub tex2: Vec4,
+}
+
+impl SurfaceTexture {
+    /// `texture` over `uvs` (zeros where there are none: then it must be constant).
+    pub fn new(
+        ctx: &Context,
+        texture: &Reflectance,
+        uvs: Option<&[Vec2]>,
+        vertex_count: usize,
+    ) -> Result<SurfaceTexture> {
+        let uvs: Vec<[f32; 2]> = match uvs {
+            Some(uvs) => uvs.iter().map(|uv| uv.to_array()).collect(),
+            None => vec![[0.0; 2]; vertex_count.max(1)],
+        };
+        let uvs = vk::upload_buffer(ctx, "uvs", &uvs, BufferUsageFlags::STORAGE_BUFFER)?;
+        let white = [[1.0f32; 4]];
+        let (width, height, texels) = match texture {
+            Reflectance::Image(t) => (t.width, t.height, t.texels.as_slice()),
+            _ => (1, 1, &white[..]),
+        };
+        let max = ctx.limits().max_image_dimension2_d;
+        if width > max || height > max {
+            return Err(bad_input!("texture {width}x{height}: this device allows at most {max} texels a side"));
+        }
+        let usage = ImageUsageFlags::SAMPLED | ImageUsageFlags::TRANSFER_DST;
+        let image =
+            Image::new_2d(ctx, "surface texture", Format::R32G32B32A32_SFLOAT, Extent2D { width, height }, 1, usage)?;
+        let mut staging = Buffer::new(
+            ctx,
+            "surface texture (staging)",
+            std::mem::size_of_val(texels) as u64,
+            BufferUsageFlags::TRANSFER_SRC,
+            MemoryLocation::CpuToGpu,
+        )?;
+        staging.write(0, texels)?;
+        ctx.submit(None, |rec| rec.copy_buffer_to_image(&staging, &image))?;
+        let sampler = Sampler::repeating(ctx)?;
+        let (tex1, tex2, kind) = match *texture {
+            Reflectance::Constant(c) => (c.extend(1.0), c.extend(1.0), 0),
+            Reflectance::Checkerboard { uscale, vscale, tex1, tex2 } => (tex1.extend(uscale), tex2.extend(vscale), 1),
+            Reflectance::Image(_) => (Vec4::ONE, Vec4::ONE, 2),
+        };
+        Ok(SurfaceTexture { uvs, image, sampler, kind, tex1, tex2 })
+    }
+
+    /// A translucent object's scatter weight under `model`: its texture's reflectance turned
+    /// into the weight on its material ([`ScatterWeight`]), or 1 everywhere without a texture.
+    pub fn scatter_weight(
+        ctx: &Context,
+        object: &Object,
+        (model, diffusion): (Model, Diffusion),
+        vertex_count: usize,
+    ) -> Result<SurfaceTexture> {
+        let curve = object.texture.as_ref().map(|_| ScatterWeight::new(&object.material, model, diffusion));
+        let weight = |c: Vec3| {
+            let w = curve.as_ref().map_or([1.0; 3], |curve| curve.of([c.x as f64, c.y as f64, c.z as f64]));
+            Vec3::new(w[0] as f32, w[1] as f32, w[2] as f32)
+        };
+        let texture = match &object.texture {
+            None => Reflectance::Constant(Vec3::ONE),
+            Some(Reflectance::Constant(c)) => Reflectance::Constant(weight(*c)),
+            Some(Reflectance::Checkerboard { uscale, vscale, tex1, tex2 }) => {
+                Reflectance::Checkerboard { uscale: *uscale, vscale: *vscale, tex1: weight(*tex1), tex2: weight(*tex2) }
+            }
+            Some(Reflectance::Image(t)) => {
+                let texels = t.texels.iter().map(|p| weight(Vec3::new(p[0], p[1], p[2])).extend(1.0).to_array());
+                Reflectance::Image(Texture {
+                    name: t.name.clone(),
+                    width: t.width,
+                    height: t.height,
+                    texels: std::sync::Arc::new(texels.collect()),
+                })
+            }
+        };
+        SurfaceTexture::new(ctx, &texture, object.uvs.as_deref(), vertex_count)
+    }
+
+    /// The draw into the G-buffer as object `id`, seen through `view_projection`.
+    pub fn surface_constants(&self, view_projection: glam::Mat4, id: u32) -> SurfaceConstants {
+        let (tex1, tex2, texture_kind) = (self.tex1, self.tex2, self.kind);
+        SurfaceConstants { view_projection, tex1, tex2, object: id, texture_kind, pad: [0; 2] }
+    }
+}
+
 /// One opaque object on the GPU.
 pub struct GpuOpaque {
     pub vertices: Buffer,
     pub indices: Buffer,
     pub index_count: u32,
-    /// One uv per vertex (zeros when the mesh has none).
-    pub uvs: Buffer,
-    /// The reflectance image (one white texel when the reflectance is not an image), and its
-    /// repeating sampler.
-    pub texture: Image,
-    pub sampler: Sampler,
+    /// Its reflectance.
+    pub texture: SurfaceTexture,
     pub bounds: (Vec3, Vec3),
     /// What it was made from.
     pub made_from: Opaque,
@@ -92,51 +191,9 @@ impl GpuOpaque {
     fn new(ctx: &Context, opaque: &Opaque) -> Result<GpuOpaque> {
         let mesh = opaque.world_mesh();
         let (vertices, indices, index_count) = upload_mesh(ctx, &mesh)?;
-        let uvs: Vec<[f32; 2]> = match &opaque.uvs {
-            Some(uvs) => uvs.iter().map(|uv| uv.to_array()).collect(),
-            None => vec![[0.0; 2]; mesh.positions.len()],
-        };
-        let uvs = vk::upload_buffer(ctx, "uvs", &uvs, BufferUsageFlags::STORAGE_BUFFER)?;
-        let white = [[1.0f32; 4]];
-        let (width, height, texels) = match &opaque.reflectance {
-            Reflectance::Image(t) => (t.width, t.height, t.texels.as_slice()),
-            _ => (1, 1, &white[..]),
-        };
-        let max = ctx.limits().max_image_dimension2_d;
-        if width > max || height > max {
-            return Err(bad_input!("texture {width}x{height}: this device allows at most {max} texels a side"));
-        }
-        let usage = ImageUsageFlags::SAMPLED | ImageUsageFlags::TRANSFER_DST;
-        let texture = Image::new_2d(
-            ctx,
-            "reflectance texture",
-            Format::R32G32B32A32_SFLOAT,
-            Extent2D { width, height },
-            1,
-            usage,
-        )?;
-        let mut staging = Buffer::new(
-            ctx,
-            "reflectance texture (staging)",
-            std::mem::size_of_val(texels) as u64,
-            BufferUsageFlags::TRANSFER_SRC,
-            MemoryLocation::CpuToGpu,
-        )?;
-        staging.write(0, texels)?;
-        ctx.submit(None, |rec| rec.copy_buffer_to_image(&staging, &texture))?;
-        let sampler = Sampler::repeating(ctx)?;
+        let texture = SurfaceTexture::new(ctx, &opaque.reflectance, opaque.uvs.as_deref(), mesh.positions.len())?;
         let bounds = mesh.bounds();
-        Ok(GpuOpaque { vertices, indices, index_count, uvs, texture, sampler, bounds, made_from: opaque.clone() })
-    }
-
-    /// Its draw into the G-buffer as object `id`, seen through `view_projection`.
-    pub fn surface_constants(&self, view_projection: glam::Mat4, id: u32) -> DiffuseSurfaceConstants {
-        let (tex1, tex2, checker) = match self.made_from.reflectance {
-            Reflectance::Constant(c) => (c.extend(1.0), c.extend(1.0), 0),
-            Reflectance::Checkerboard { uscale, vscale, tex1, tex2 } => (tex1.extend(uscale), tex2.extend(vscale), 1),
-            Reflectance::Image(_) => (glam::Vec4::ONE, glam::Vec4::ONE, 2),
-        };
-        DiffuseSurfaceConstants { view_projection, tex1, tex2, object: id, checker, pad: [0; 2] }
+        Ok(GpuOpaque { vertices, indices, index_count, texture, bounds, made_from: opaque.clone() })
     }
 }
 
@@ -204,6 +261,7 @@ impl GpuWorld {
         )?;
         let diffusion = desc.integration.diffusion;
         let table = TableProfile::of(desc.integration.model);
+        let weight_model = (desc.integration.model, diffusion);
         let bounds: Vec<(Vec3, Vec3)> = world.objects.iter().map(|o| o.world_mesh().bounds()).collect();
         let opaque_bounds = world.opaque.iter().map(|o| o.world_mesh().bounds()).reduce(union);
         for (i, (object, &point_count)) in world.objects.iter().zip(&point_counts).enumerate() {
@@ -221,8 +279,13 @@ impl GpuWorld {
                     table,
                     mm_per_unit: world.mm_per_unit,
                     samples: object.samples,
+                    texture: object.texture.clone(),
+                    uvs: object.uvs.clone(),
+                    weight_model,
                 };
-                self.objects.push(GpuObject::new(ctx, &desc.lights, &options, made_from, others)?);
+                let vertex_count = made_from.mesh.positions.len();
+                let texture = SurfaceTexture::scatter_weight(ctx, object, weight_model, vertex_count)?;
+                self.objects.push(GpuObject::new(ctx, &desc.lights, &options, made_from, texture, others)?);
                 continue;
             };
             let mesh_changed = *mesh != g.made_from.mesh;
@@ -266,6 +329,18 @@ impl GpuWorld {
                 g.made_from.mesh = mesh.into_owned();
             }
             g.made_from.samples = object.samples;
+            // The scatter weight is the texture's reflectance over the material's.
+            if object.material != g.made_from.material
+                || object.texture != g.made_from.texture
+                || object.uvs != g.made_from.uvs
+                || (object.texture.is_some() && weight_model != g.made_from.weight_model)
+            {
+                ctx.wait_idle()?;
+                let vertex_count = g.made_from.mesh.positions.len();
+                g.texture = SurfaceTexture::scatter_weight(ctx, object, weight_model, vertex_count)?;
+                (g.made_from.texture, g.made_from.uvs) = (object.texture.clone(), object.uvs.clone());
+                g.made_from.weight_model = weight_model;
+            }
             if params_changed {
                 g.made_from.material = object.material.clone();
                 (g.made_from.diffusion, g.made_from.mm_per_unit) = (diffusion, world.mm_per_unit);
@@ -337,6 +412,7 @@ impl GpuObject {
         lights: &[Light],
         options: &HierarchyOptions,
         made_from: MadeFrom,
+        texture: SurfaceTexture,
         casters: Option<(Vec3, Vec3)>,
     ) -> Result<GpuObject> {
         let mesh = &made_from.mesh;
@@ -370,6 +446,7 @@ impl GpuObject {
             bounds: made_from.mesh.bounds(),
             params,
             sd_table,
+            texture,
             made_from,
         })
     }

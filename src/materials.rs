@@ -6,7 +6,8 @@
 
 use crate::bad_input;
 use crate::error::Result;
-use crate::physics::{dipole, Diffusion, Medium};
+use crate::physics::beam_diffusion::{self, BeamMedium};
+use crate::physics::{dipole, dirpole, Diffusion, Medium, Model};
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
@@ -163,6 +164,37 @@ impl Material {
         Ok(())
     }
 
+    /// Per channel, the total diffuse reflectance Rd(α') of the classical dipole at the
+    /// channel's reduced albedo (Jensen et al. 2001, eq. 5 integrated): what pbrt-v4's
+    /// `subsurface "reflectance"` states and [`crate::pbrt::from_reflectance`] inverts.
+    pub fn reflectance(&self) -> [f64; 3] {
+        [0, 1, 2].map(|ch| {
+            let c = self.channel(ch).constants(Diffusion::Classical);
+            if c.transports {
+                dipole::total_rd(c.alpha_reduced, c.a_dipole)
+            } else {
+                0.0
+            }
+        })
+    }
+
+    /// This material with the total diffuse reflectance `rho` per channel (each below the
+    /// classical dipole's Rd at albedo 1, else held just under it) and the same mean free path,
+    /// g and η: the inversion of [`crate::pbrt::from_reflectance`], per channel.
+    pub fn with_reflectance(&self, rho: [f64; 3]) -> Result<Material> {
+        let top = crate::pbrt::max_reflectance(self.eta) * 0.999;
+        let mut m = self.clone();
+        for ch in 0..3 {
+            let c = self.channel(ch).constants(Diffusion::Classical);
+            let mfp = [1.0 / c.sigma_t_reduced.max(MIN_SIGMA); 3];
+            let (a, s) = crate::pbrt::from_reflectance([rho[ch].clamp(0.0, top); 3], mfp, self.g[ch], self.eta)
+                .map_err(|why| bad_input!("{}: {why}", self.name))?;
+            (m.sigma_a[ch], m.sigma_s[ch]) = (a[ch], s[ch]);
+        }
+        m.validate()?;
+        Ok(m)
+    }
+
     pub fn channel(&self, ch: usize) -> Medium {
         Medium { sigma_a: self.sigma_a[ch], sigma_s: self.sigma_s[ch], g: self.g[ch], eta: self.eta }
     }
@@ -226,4 +258,127 @@ pub fn materials_table() -> String {
         );
     }
     out
+}
+
+/// How a texture's reflectance weighs a translucent material under one model.
+///
+/// A textured translucent object keeps its material's coefficients and weighs each source
+/// point's irradiance and each pixel's sum by the scatter weight of the texture there,
+/// √(T(α'(ρ)) / T(α')) per channel: α'(ρ) the reduced albedo whose classical-dipole Rd is the
+/// texture's reflectance ρ (what pbrt-v4's `reflectance` states, inverted as
+/// [`crate::pbrt::from_reflectance`] does, with the material's mean free path), T the model's own
+/// total diffuse reflectance at normal incidence, α' the material's. A pair (xi, xo) is so weighed
+/// by √(w(xi) w(xo)): the geometric mean of the entry's and the exit's ratio, symmetric as the
+/// BSSRDF is. Where the texture is uniform the object reflects in total what a material of that
+/// colour reflects, and across a change of colour the weight blends over the profile's width.
+/// What it leaves out: the profile's width stays the material's (a darker colour would also
+/// shorten the diffusion length); tests/texture.rs measures both.
+///
+/// T is the classical dipole's Rd (closed form) for `dipole`, the directional dipole's plane
+/// integral for `directional`, photon beam diffusion's for `pbd` and, standing in for the Monte
+/// Carlo table's (measured per material, a second or two each), for `mc` too: tabulated over α'
+/// here (their error is measured in tests/texture.rs).
+pub struct ScatterWeight {
+    /// Per channel, (Rd(α'_k), T(α'_k)) at nodes ascending in α'; empty where the material does
+    /// not scatter.
+    curves: [Vec<(f64, f64)>; 3],
+    /// T at the material's own reflectance, through the same curve (so its own colour weighs 1).
+    own: [f64; 3],
+}
+
+/// α' nodes of the directional dipole's curve: denser toward 1, where Rd climbs steeply.
+const WEIGHT_NODES: usize = 48;
+
+impl ScatterWeight {
+    pub fn new(material: &Material, model: Model, diffusion: Diffusion) -> ScatterWeight {
+        let rd = material.reflectance();
+        let curves = [0, 1, 2].map(|ch| {
+            let m = material.channel(ch);
+            let c = m.constants(Diffusion::Classical);
+            if !c.transports {
+                return Vec::new();
+            }
+            let at = |alpha: f64| Medium {
+                sigma_a: (1.0 - alpha) * c.sigma_t_reduced,
+                sigma_s: alpha * c.sigma_t_reduced / (1.0 - m.g),
+                g: m.g,
+                eta: m.eta,
+            };
+            (0..=WEIGHT_NODES)
+                .map(|k| {
+                    let x = k as f64 / WEIGHT_NODES as f64;
+                    // From 1e-3 to 0.9995: at α' = 1 nothing is absorbed and σtr is 0.
+                    let alpha = 1e-3 + (0.9995 - 1e-3) * (1.0 - (1.0 - x) * (1.0 - x));
+                    let medium = at(alpha);
+                    let classical = dipole::total_rd(alpha, c.a_dipole);
+                    let total = match model {
+                        Model::Directional => directional_total(&medium.constants(diffusion)),
+                        Model::Dipole => classical,
+                        // The Monte Carlo table's exact transport is measured per material (a
+                        // second or two): beam diffusion, its closest closed form, stands in.
+                        Model::Pbd | Model::Mc => {
+                            let b = BeamMedium::new(&medium);
+                            if b.transports() {
+                                beam_diffusion::disc_integral(&b, 40.0 / b.sigma_tr.max(1e-9 * c.sigma_t_reduced))
+                            } else {
+                                0.0
+                            }
+                        }
+                    };
+                    (classical, total)
+                })
+                .collect()
+        });
+        let own = [0, 1, 2].map(|ch| total_at(&curves[ch], rd[ch]));
+        ScatterWeight { curves, own }
+    }
+
+    /// The scatter weight of reflectance `rho` (per channel; 0 where the material or the
+    /// colour reflects nothing).
+    pub fn of(&self, rho: [f64; 3]) -> [f64; 3] {
+        [0, 1, 2].map(|ch| {
+            if self.own[ch] > 0.0 {
+                (total_at(&self.curves[ch], rho[ch]) / self.own[ch]).sqrt()
+            } else {
+                0.0
+            }
+        })
+    }
+}
+
+/// T at classical reflectance `rho` on a curve of (Rd, T) nodes ascending: linear between nodes,
+/// through 0 below the first, held above the last.
+fn total_at(curve: &[(f64, f64)], rho: f64) -> f64 {
+    let Some(&(first_rd, first_t)) = curve.first() else { return 0.0 };
+    let rho = rho.max(0.0);
+    if rho <= first_rd {
+        return if first_rd > 0.0 { first_t * rho / first_rd } else { 0.0 };
+    }
+    for w in curve.windows(2) {
+        let ((r0, t0), (r1, t1)) = (w[0], w[1]);
+        if rho <= r1 {
+            return t0 + (t1 - t0) * (rho - r0) / (r1 - r0).max(f64::MIN_POSITIVE);
+        }
+    }
+    curve.last().map_or(0.0, |&(_, t)| t)
+}
+
+/// The directional dipole's total diffuse reflectance at normal incidence, 2π∫Sd(r) r dr over
+/// the plane (it is radially symmetric there), on log-spaced radii from 1e-6 to 40 diffusion
+/// lengths (midpoint rule in ln r; 400 nodes hold it to 1e-4).
+fn directional_total(c: &crate::physics::ChannelConstants) -> f64 {
+    use glam::DVec3;
+    if !c.transports || c.sigma_tr.is_nan() || c.sigma_tr <= 0.0 {
+        return 0.0;
+    }
+    let (lo, hi) = (1e-6f64.ln(), (40.0 / c.sigma_tr).ln());
+    let nodes = 400;
+    let h = (hi - lo) / nodes as f64;
+    let n = DVec3::Y;
+    (0..nodes)
+        .map(|i| {
+            let r = (lo + (i as f64 + 0.5) * h).exp();
+            dirpole::sd(c, DVec3::new(r, 0.0, 0.0), n, n, DVec3::ZERO, n) * std::f64::consts::TAU * r * r * h
+        })
+        .sum()
 }

@@ -6,7 +6,7 @@ pub mod off;
 pub mod ply;
 
 use std::f32::consts::PI;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use glam::{Vec2, Vec3};
 
@@ -88,6 +88,48 @@ pub fn raw_from_bytes(bytes: &[u8], format: MeshFormat, shown: &str) -> Result<R
     }
 }
 
+/// The diffuse colour map (`map_Kd`, times `Kd` when the material gives one) of the first
+/// material an OBJ file uses that has one, through its `mtllib` (relative to the OBJ file, at most
+/// [`MAX_MESH_BYTES`], read by tobj): what colours a translucent OBJ (README "Textured translucent
+/// materials"). `None` when the file names no library or no material with a map; a library or map
+/// that cannot be read is an error naming it. Later materials' maps are left out with a warning
+/// (one texture per object).
+pub fn obj_diffuse_map(path: &Path) -> Result<Option<(PathBuf, Vec3)>> {
+    let shown = path.display();
+    let text = String::from_utf8_lossy(&read_mesh_file(path)?).into_owned();
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let words = |key: &'static str| {
+        text.lines()
+            .filter_map(move |l| l.trim().strip_prefix(key).filter(|r| r.starts_with([' ', '\t'])).map(str::trim))
+    };
+    let used: Vec<&str> = words("usemtl").collect();
+    let mut maps = Vec::new();
+    for lib in words("mtllib") {
+        let lib_path = dir.join(lib);
+        let bytes = read_mesh_file(&lib_path).map_err(|e| bad_input!("mesh {shown}: mtllib {lib}: {e}"))?;
+        let (materials, _) = tobj::load_mtl_buf(&mut std::io::BufReader::new(bytes.as_slice()))
+            .map_err(|e| bad_input!("mesh {shown}: mtllib {lib}: not a readable MTL file: {e}"))?;
+        for m in materials {
+            if let Some(map) = m.diffuse_texture.as_ref().filter(|_| used.is_empty() || used.contains(&m.name.as_str()))
+            {
+                let factor = m.diffuse.map_or(Vec3::ONE, Vec3::from);
+                let map_dir = lib_path.parent().unwrap_or(dir);
+                maps.push((m.name.clone(), map_dir.join(map.trim()), factor));
+            }
+        }
+    }
+    // In the order the file uses them.
+    maps.sort_by_key(|(name, _, _)| used.iter().position(|u| u == name).unwrap_or(usize::MAX));
+    if maps.len() > 1 {
+        crate::note!(
+            "warning: mesh {shown}: {} materials have a map_Kd; the object takes the first, {} (one texture per object)",
+            maps.len(),
+            maps[0].1.display()
+        );
+    }
+    Ok(maps.into_iter().next().map(|(_, map, factor)| (map, factor)))
+}
+
 /// Decompresses a gzip file, bounded like an uncompressed one (a small file that inflates past
 /// [`MAX_MESH_BYTES`] is refused as it is read, not after).
 pub fn gunzip(bytes: &[u8], shown: &str) -> Result<Vec<u8>> {
@@ -164,6 +206,7 @@ impl Mesh {
 
         let mut mesh = Mesh { positions: Vec::new(), normals: Vec::new(), indices: Vec::new() };
         let mut have_normals = true;
+        let mut uvs = Some(Vec::new());
         for model in &models {
             let m = &model.mesh;
             let base = mesh.positions.len() as u32;
@@ -175,6 +218,11 @@ impl Mesh {
                 have_normals = false;
                 mesh.normals.extend(std::iter::repeat_n(Vec3::ZERO, count));
             }
+            // `vt` for every vertex of every object, or no uv at all.
+            match (&mut uvs, m.texcoords.len() == 2 * count) {
+                (Some(uvs), true) => uvs.extend(m.texcoords.chunks_exact(2).map(|t| Vec2::new(t[0], t[1]))),
+                _ => uvs = None,
+            }
             for &i in &m.indices {
                 if i as usize >= count {
                     return Err(bad_input!("mesh {shown}: object '{}' has a vertex index out of range", model.name));
@@ -185,7 +233,7 @@ impl Mesh {
         Ok(RawMesh {
             positions: mesh.positions,
             normals: have_normals.then_some(mesh.normals),
-            uvs: None,
+            uvs: uvs.filter(|uvs| !uvs.is_empty()),
             indices: mesh.indices,
         })
     }

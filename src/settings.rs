@@ -216,7 +216,20 @@ impl RenderSettings {
             None => None,
         };
         let material = args.material.material()?;
+        let spec = SceneSettings::from_args(args).mesh_spec();
+        let texture = obj_texture(&spec)?;
+        // A colour map: the material's albedo is the map's mean (its mean free path is kept).
+        let material = match &texture {
+            Some((map, _)) => {
+                let mean = map.mean();
+                material.with_reflectance([mean.x as f64, mean.y as f64, mean.z as f64])?
+            }
+            None => material,
+        };
         let mut s = RenderSettings::new(scene, material);
+        if let Some((map, uvs)) = texture {
+            (s.world.objects[0].texture, s.world.objects[0].uvs) = (Some(map), Some(uvs));
+        }
         s.desc.environment = environment;
         s.world.objects[0].samples = args.samples;
         let d = &mut s.desc;
@@ -241,6 +254,28 @@ impl RenderSettings {
         s.world.validate()?;
         Ok(s)
     }
+}
+
+/// The colour map of an OBJ mesh file (`map_Kd` × `Kd` of its first textured material, through
+/// its `mtllib`) and the file's uv per vertex; `None` for other meshes and OBJ files without one.
+fn obj_texture(spec: &str) -> Result<Option<(crate::world::Reflectance, Vec<glam::Vec2>)>> {
+    use crate::mesh::MeshFormat;
+    let path = std::path::Path::new(spec);
+    let is_obj = MeshFormat::of(path).0 == MeshFormat::Obj && !spec.contains("{frame}");
+    if !is_obj || !path.is_file() {
+        return Ok(None);
+    }
+    let Some((map, factor)) = crate::mesh::obj_diffuse_map(path)? else { return Ok(None) };
+    let shown = format!("mesh {spec}: map_Kd {}", map.display());
+    let uvs = crate::mesh::read_raw(path)?
+        .uvs
+        .ok_or_else(|| bad_input!("{shown}: a colour map needs the mesh's texture coordinates (vt on every vertex)"))?;
+    let mut texture = crate::world::Texture::load(&map, &shown)?;
+    if factor != Vec3::ONE {
+        let texels = texture.texels.iter().map(|t| [t[0] * factor.x, t[1] * factor.y, t[2] * factor.z, 1.0]);
+        texture.texels = std::sync::Arc::new(texels.collect());
+    }
+    Ok(Some((crate::world::Reflectance::Image(texture), uvs)))
 }
 
 /// `--env FILE | const:L` with its scale, rotation and sample count.

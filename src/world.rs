@@ -85,6 +85,18 @@ pub enum Reflectance {
     Image(Texture),
 }
 
+impl Reflectance {
+    /// The mean over the surface's uv square: a checkerboard's two values equally, an image's
+    /// texels (summed in f64).
+    pub fn mean(&self) -> Vec3 {
+        match self {
+            Reflectance::Constant(c) => *c,
+            Reflectance::Checkerboard { tex1, tex2, .. } => (*tex1 + *tex2) * 0.5,
+            Reflectance::Image(t) => Vec3::from(t.mean().map(|c| c as f32)),
+        }
+    }
+}
+
 /// An image of linear reflectances, rows from the top.
 #[derive(Clone, Debug)]
 pub struct Texture {
@@ -173,7 +185,7 @@ impl Texture {
         Ok(Texture { name: shown.to_string(), width, height, texels: std::sync::Arc::new(texels) })
     }
 
-    /// The mean texel per channel (linear reflectance).
+    /// The mean texel per channel (linear reflectance), summed in f64.
     pub fn mean(&self) -> [f64; 3] {
         let mut sum = [0.0f64; 3];
         for t in self.texels.iter() {

@@ -405,15 +405,20 @@ fn sampling_refuses_buffers_smaller_than_its_counts_need() {
     let buffer = |name: &str, bytes: u64| Buffer::new(&ctx, name, bytes, storage, MemoryLocation::GpuOnly).unwrap();
     let points = buffer("points", 1000 * 64);
     let pass = SamplingPass::new(&ctx).unwrap();
+    let white = translucent::world::Reflectance::Constant(glam::Vec3::ONE);
+    let none = translucent::gpu_world::SurfaceTexture::new(&ctx, &white, None, 1).unwrap();
     let old_size = buffer("triangle area prefix sum", (t as u64 + 1) * 4);
-    let e = ctx.submit(None, |rec| pass.record(rec, &vertices, &indices, t, &old_size, &points, 1000, 1)).unwrap_err();
+    let e = ctx
+        .submit(None, |rec| pass.record(rec, &vertices, &indices, &none, t, &old_size, &points, 1000, 1))
+        .unwrap_err();
     assert!(e.to_string().contains("triangle area prefix sum"), "{e}");
     assert_eq!(prefix_bytes(t), 8 + (t as u64 + 1) * 8);
     let right = buffer("triangle area prefix sum", prefix_bytes(t));
-    ctx.submit(None, |rec| pass.record(rec, &vertices, &indices, t, &right, &points, 1000, 1)).unwrap();
-    let e = ctx.submit(None, |rec| pass.record(rec, &vertices, &indices, t, &right, &points, 1001, 1)).unwrap_err();
+    ctx.submit(None, |rec| pass.record(rec, &vertices, &indices, &none, t, &right, &points, 1000, 1)).unwrap();
+    let e =
+        ctx.submit(None, |rec| pass.record(rec, &vertices, &indices, &none, t, &right, &points, 1001, 1)).unwrap_err();
     assert!(e.to_string().contains("points"), "{e}");
-    drop((pass, old_size, right, points, vertices, indices));
+    drop((pass, old_size, right, points, vertices, indices, none));
     drop(ctx);
     assert_clean(&counts);
 }

@@ -79,9 +79,9 @@ fn shading_params_and_tree_match_glsl() {
         offset_of!(SurfacePoint, normal),
         offset_of!(SurfacePoint, triangle),
         offset_of!(SurfacePoint, irradiance),
-        offset_of!(SurfacePoint, pad0),
+        offset_of!(SurfacePoint, scatter_weight_rg),
         offset_of!(SurfacePoint, light_dir),
-        offset_of!(SurfacePoint, pad1),
+        offset_of!(SurfacePoint, scatter_weight_b),
     ]
     .iter()
     .map(|&o| o as u32)
@@ -170,6 +170,9 @@ fn push_constants_match_glsl() {
         offset_of!(SampleConstants, point_count),
         offset_of!(SampleConstants, triangle_count),
         offset_of!(SampleConstants, seed),
+        offset_of!(SampleConstants, texture_kind),
+        offset_of!(SampleConstants, tex1),
+        offset_of!(SampleConstants, tex2),
     ];
     assert_eq!(offsets("hierarchy/sample_points.comp", "SampleConstants"), sample.map(|o| o as u32));
     let morton = [
@@ -193,20 +196,20 @@ fn push_constants_match_glsl() {
         offset_of!(TileCutConstants, pad1),
     ];
     assert_eq!(offsets("tile_cut.comp", "TileCutConstants"), cut.map(|o| o as u32));
-    // The opaque objects' passes.
-    use translucent::gpu::{DiffuseConstants, DiffuseSurfaceConstants};
+    // The surface pass, and the opaque objects' shading.
+    use translucent::gpu::{DiffuseConstants, SurfaceConstants};
     let surface = [
-        offset_of!(DiffuseSurfaceConstants, view_projection),
-        offset_of!(DiffuseSurfaceConstants, tex1),
-        offset_of!(DiffuseSurfaceConstants, tex2),
-        offset_of!(DiffuseSurfaceConstants, object),
-        offset_of!(DiffuseSurfaceConstants, checker),
+        offset_of!(SurfaceConstants, view_projection),
+        offset_of!(SurfaceConstants, tex1),
+        offset_of!(SurfaceConstants, tex2),
+        offset_of!(SurfaceConstants, object),
+        offset_of!(SurfaceConstants, texture_kind),
     ];
-    for shader in ["surface_diffuse.vert", "surface_diffuse.frag"] {
-        let glsl = offsets(shader, "DiffuseSurfaceConstants");
+    for shader in ["surface.vert", "surface.frag"] {
+        let glsl = offsets(shader, "SurfaceConstants");
         assert_eq!(glsl[..surface.len()], surface.map(|o| o as u32), "{shader}");
     }
-    assert_eq!(size_of::<DiffuseSurfaceConstants>(), 112);
+    assert_eq!(size_of::<SurfaceConstants>(), 112);
     assert_eq!(offsets("diffuse.frag", "DiffuseConstants")[0], offset_of!(DiffuseConstants, first_opaque) as u32);
     assert_eq!(size_of::<DiffuseConstants>(), 16);
     let debug = [offset_of!(DebugConstants, view_projection), offset_of!(DebugConstants, color_scale)];

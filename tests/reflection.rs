@@ -17,7 +17,7 @@ fn shade_frag_declares_its_buffers_texels_and_images() {
     assert_eq!(r.stage, Stage::Fragment);
     let numbers: Vec<u32> = r.bindings.iter().map(|b| b.binding).collect();
     assert_eq!(numbers, (0..numbers.len() as u32).collect::<Vec<_>>(), "bindings 0..n in order");
-    assert_eq!(r.bindings.len(), 17, "{:?}", r.bindings);
+    assert_eq!(r.bindings.len(), 18, "{:?}", r.bindings);
     for b in &r.bindings {
         assert_eq!((b.set, b.count), (0, 1), "{b:?}");
         let expected = match b.binding {
@@ -29,8 +29,8 @@ fn shade_frag_declares_its_buffers_texels_and_images() {
             4 => (DescriptorKind::StorageBuffer, true),
             // sampler2DArrayShadow, and the same map's depth (sampler2DArray): combined image samplers.
             5 | 16 => (DescriptorKind::CombinedImageSampler, true),
-            // The G-buffer's position and normal, read.
-            8 | 9 => (DescriptorKind::StorageImage, true),
+            // The G-buffer's position, normal and texture (the scatter weight), read.
+            8 | 9 | 17 => (DescriptorKind::StorageImage, true),
             // Nodes, points, their light records, the tile lists and the dipole table: texels.
             _ => (DescriptorKind::UniformTexelBuffer, true),
         };

@@ -1,6 +1,6 @@
 #version 460
 // Irradiance entering each point from every light: E_k = I · max(0, n·l) · Ft(eta, n·l) ·
-// visibility, merged into one PointFlux whatever the number of lights (the E-weighted sums of
+// visibility (times the point's scatter weight where the object is textured), merged into one PointFlux whatever the number of lights (the E-weighted sums of
 // the directions toward them and of their refracted cosines, per channel); their sum and irradiance-weighted mean direction in the
 // point itself (for views and tools); and, for brute force only (per_light_records = 1), each
 // light's own PointLight.
@@ -67,6 +67,7 @@ void main() {
     float weight = 0.0;
     vec3 first = vec3(0.0);
     mat3 second = mat3(0.0);
+    vec3 scatter_weight = scatter_weight_of(p);
     for (uint k = 0u; k < light_set.light_count; ++k) {
         vec3 toward;
         // light_irradiance (lights.glsl): the shade pass computes its pixel's own the same way;
@@ -74,6 +75,9 @@ void main() {
         vec3 e = light_irradiance(light_of(k), p.position, p.normal, toward);
         vec4 term = flux_term(toward, p.normal);
         e *= table_incidence_factor(sd_table, term.w);
+        // The object's texture here (1 without one): what enters is weighed by it, so that every
+        // sum over points and nodes carries the source's colour (gpu_world::SurfaceTexture).
+        e *= scatter_weight;
         if (pc.per_light_records != 0u) point_lights[i * light_set.light_count + k] = PointLight(e, encode_oct(toward));
         if (e == vec3(0.0)) continue;
         vec3 wi = term.xyz;

@@ -6,13 +6,24 @@
 // values fall onto a coarse lattice (at i = 1.6M, multiples of 1/8) and the points clump.
 #include "points.glsl"
 #include "fixed64.glsl"
+#include "surface_texture.glsl"
 layout(local_size_x = 64) in;
 layout(std430, binding = 0) readonly buffer Vertices { float vertex_data[]; };
 layout(std430, binding = 1) readonly buffer Indices { uint indices[]; };
 // In units of total area / (N · 2^20): see triangle_areas.comp.
 layout(std430, binding = 2) readonly buffer AreaPrefix { float total_area; uint pad; uvec2 prefix[]; };
 layout(std430, binding = 3) writeonly buffer Points { SurfacePoint points[]; };
-layout(push_constant) uniform SampleConstants { uint point_count; uint triangle_count; uint seed; } pc;
+// The object's texture (its scatter weight; surface_texture.glsl) and one uv per vertex.
+layout(std430, binding = 4) readonly buffer Uvs { vec2 uvs[]; };
+layout(binding = 5) uniform sampler2D texture_map;
+layout(push_constant) uniform SampleConstants {
+    uint point_count;
+    uint triangle_count;
+    uint seed;
+    uint texture_kind;  // TEXTURE_*: TEXTURE_CONSTANT reads no uv
+    vec4 tex1;
+    vec4 tex2;
+} pc;
 
 vec3 position(uint v) { return vec3(vertex_data[6 * v], vertex_data[6 * v + 1], vertex_data[6 * v + 2]); }
 vec3 normal_of(uint v) { return vec3(vertex_data[6 * v + 3], vertex_data[6 * v + 4], vertex_data[6 * v + 5]); }
@@ -60,8 +71,14 @@ void main() {
     p.normal = n;
     p.triangle = t;
     p.irradiance = vec3(0.0);
-    p.pad0 = 0.0;
+    // The texture at the point's uv: its scatter weight, which the irradiance pass applies.
+    vec3 weight = pc.tex1.rgb;
+    if (pc.texture_kind != TEXTURE_CONSTANT) {
+        vec2 uv = bary.x * uvs[ia] + bary.y * uvs[ib] + bary.z * uvs[ic];
+        weight = surface_texture(pc.texture_kind, pc.tex1, pc.tex2, texture_map, uv);
+    }
+    p.scatter_weight_rg = packHalf2x16(weight.rg);
     p.light_dir = vec3(0.0);
-    p.pad1 = 0.0;
+    p.scatter_weight_b = weight.b;
     points[i] = p;
 }

@@ -10,12 +10,15 @@ struct SurfacePoint {
     float area;        // total area / N
     vec3 normal;
     uint triangle;     // the triangle it was sampled on
-    vec3 irradiance;   // W/m² per RGB entering the surface: I cos Ft(eta) visibility, summed over lights
-    float pad0;
+    vec3 irradiance;   // W/m² per RGB entering the surface: I cos Ft(eta) visibility, summed over
+                       // lights, times the scatter weight
+    uint scatter_weight_rg; // the object's texture here (1 without one: gpu_world::SurfaceTexture),
+                       // r and g as two f16; the irradiance pass weighs what enters by it
     vec3 light_dir;    // irradiance-weighted mean direction toward the lights (unit, or 0 if unlit;
                        // for views and tools: shading uses PointFlux)
-    float pad1;
+    float scatter_weight_b;
 };
+vec3 scatter_weight_of(SurfacePoint p) { return vec3(unpackHalf2x16(p.scatter_weight_rg), p.scatter_weight_b); }
 
 // What one light brings to one point (16 bytes), at [point · light_count + light]: kept only for
 // brute force, the exact sum over lights that the merged records below are measured against.

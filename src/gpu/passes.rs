@@ -80,6 +80,10 @@ pub struct SampleConstants {
     pub point_count: u32,
     pub triangle_count: u32,
     pub seed: u32,
+    /// The object's texture (its scatter weight), as [`SurfaceConstants`](crate::gpu::SurfaceConstants) gives it.
+    pub texture_kind: u32,
+    pub tex1: Vec4,
+    pub tex2: Vec4,
 }
 
 /// Mirrors the push constants of shaders/hierarchy/morton.comp.

@@ -11,10 +11,12 @@ pub struct SurfacePoint {
     pub area: f32,
     pub normal: Vec3,
     pub triangle: u32,
+    /// Times the scatter weight.
     pub irradiance: Vec3,
-    pub pad0: f32,
+    /// The object's texture at the point (1 without one), r and g as two f16.
+    pub scatter_weight_rg: u32,
     pub light_dir: Vec3,
-    pub pad1: f32,
+    pub scatter_weight_b: f32,
 }
 
 /// Mirrors `PointLight` in shaders/include/points.glsl (16 bytes): one light at one point (kept

@@ -40,20 +40,21 @@ impl WorkCounters {
     }
 }
 
-/// Mirrors `DiffuseSurfaceConstants` in shaders/include/diffuse_constants.glsl: an opaque
-/// object's draw into the G-buffer.
+/// Mirrors `SurfaceConstants` in shaders/include/surface_constants.glsl: an object's draw into
+/// the G-buffer.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct DiffuseSurfaceConstants {
+pub struct SurfaceConstants {
     pub view_projection: Mat4,
-    /// rgb: the reflectance (a checkerboard's first); w: the checkerboard's u scale.
+    /// rgb: the texture's value (a checkerboard's first); w: the checkerboard's u scale.
     pub tex1: Vec4,
-    /// rgb: a checkerboard's second reflectance; w: its v scale.
+    /// rgb: a checkerboard's second value; w: its v scale.
     pub tex2: Vec4,
     /// The object's G-buffer id (position w = object + 1).
     pub object: u32,
-    /// 1 for a checkerboard over the mesh's uv, 2 for its image, 0 for `tex1` everywhere.
-    pub checker: u32,
+    /// surface_texture.glsl's kinds: 0 `tex1` everywhere, 1 a checkerboard over the mesh's uv,
+    /// 2 its image.
+    pub texture_kind: u32,
     pub pad: [u32; 2],
 }
 

@@ -1,8 +1,10 @@
 //! Surface sampling: the triangle-area prefix sum (64-bit fixed point), then N points uniform by area.
-//! Reads: vertices, indices. Writes: area prefix sum, points (unsorted).
+//! Reads: vertices, indices, the object's texture (its scatter weight, at each point's uv).
+//! Writes: area prefix sum, points (unsorted).
 
 use crate::error::Result;
 use crate::gpu::SampleConstants;
+use crate::gpu_world::SurfaceTexture;
 use crate::vk::{Bind, Buffer, Context, Pipeline, Recorder};
 
 /// Bytes of the triangle-area prefix sum for `triangles` triangles: the total area (f32 and
@@ -30,6 +32,7 @@ impl SamplingPass {
         rec: &mut Recorder,
         vertices: &Buffer,
         indices: &Buffer,
+        texture: &SurfaceTexture,
         triangle_count: u32,
         prefix: &Buffer,
         points: &Buffer,
@@ -41,7 +44,11 @@ impl SamplingPass {
         // run on lavapipe (see README "Validation").
         let n = point_count as u64;
         let t = triangle_count as u64;
-        for (buffer, needed) in [(indices, t * 12), (prefix, prefix_bytes(triangle_count)), (points, n * 64)] {
+        // A texture reads one uv (8 bytes) per vertex (24 bytes each).
+        let uv_bytes = if texture.kind != 0 { vertices.size / 24 * 8 } else { 0 };
+        let needs =
+            [(indices, t * 12), (prefix, prefix_bytes(triangle_count)), (points, n * 64), (&texture.uvs, uv_bytes)];
+        for (buffer, needed) in needs {
             if buffer.size < needed {
                 return Err(crate::runtime!(
                     "sampling: {} holds {} bytes; {triangle_count} triangles and {point_count} points need {needed}",
@@ -56,10 +63,24 @@ impl SamplingPass {
             bytemuck::bytes_of(&[triangle_count, point_count]),
             [1, 1, 1],
         )?;
-        let constants = SampleConstants { point_count, triangle_count, seed };
+        let constants = SampleConstants {
+            point_count,
+            triangle_count,
+            seed,
+            texture_kind: texture.kind,
+            tex1: texture.tex1,
+            tex2: texture.tex2,
+        };
         rec.dispatch(
             &self.points,
-            &[Bind::Read(vertices), Bind::Read(indices), Bind::Read(prefix), Bind::Write(points)],
+            &[
+                Bind::Read(vertices),
+                Bind::Read(indices),
+                Bind::Read(prefix),
+                Bind::Write(points),
+                Bind::Read(&texture.uvs),
+                Bind::Sampled(&texture.image, &texture.sampler),
+            ],
             bytemuck::bytes_of(&constants),
             [point_count.div_ceil(64), 1, 1],
         )

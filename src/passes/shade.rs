@@ -1,16 +1,16 @@
-//! The surface and shade passes. The surface pass rasterises the mesh once into a G-buffer
-//! (depth, world position, normal: shaders/surface.frag); the shade pass is a full-screen
-//! triangle per tile that, per pixel, integrates the BSSRDF over the tree (shaders/shade.frag),
-//! plus the surface's microfacet reflection. Surface reads: vertices, indices; writes: depth,
-//! position, normal, and clears colour and work counters. Shade reads: the object's and the
-//! frame's parameters, tree nodes,
-//! sorted points, their light records, lights, shadow maps, position and normal; writes: colour,
-//! work counters.
+//! The surface and shade passes. The surface pass rasterises every object's mesh once into a
+//! G-buffer (depth, world position, normal, texture: shaders/surface.frag); the shade pass is a
+//! full-screen triangle per tile that, per pixel, integrates the BSSRDF over the tree
+//! (shaders/shade.frag), plus the surface's microfacet reflection. Surface reads: vertices,
+//! indices, uvs, textures; writes: depth, position, normal, texture, and clears colour and work
+//! counters. Shade reads: the object's and the frame's parameters, tree nodes, sorted points,
+//! their light records, lights, shadow maps, position, normal and texture (the pixel's scatter
+//! weight); writes: colour, work counters.
 
 use std::collections::HashMap;
 
 use crate::error::Result;
-use crate::gpu::{DiffuseSurfaceConstants, ShadeConstants};
+use crate::gpu::{ShadeConstants, SurfaceConstants};
 use crate::physics::Model;
 use crate::vk::{
     self, Bind, Buffer, Context, CullModeFlags, Format, GraphicsDesc, Image, Pipeline, PrimitiveTopology, Recorder,
@@ -33,7 +33,7 @@ pub struct ShadeInputs<'a> {
     pub depth: &'a Image,
     pub position: &'a Image,
     pub normal: &'a Image,
-    /// The G-buffer's reflectance of opaque objects.
+    /// The G-buffer's texture: a translucent pixel's scatter weight.
     pub albedo: &'a Image,
     pub vertices: &'a Buffer,
     pub indices: &'a Buffer,
@@ -104,23 +104,21 @@ pub struct SurfaceTargets<'a> {
     pub work: &'a Buffer,
 }
 
-/// An opaque object's draw into the G-buffer.
-pub struct OpaqueDraw<'a> {
+/// An object's draw into the G-buffer.
+pub struct SurfaceDraw<'a> {
     pub vertices: &'a Buffer,
     pub indices: &'a Buffer,
     pub index_count: u32,
     /// One uv per vertex.
     pub uvs: &'a Buffer,
-    /// Its reflectance image and sampler.
+    /// Its texture's image and sampler (gpu_world::SurfaceTexture).
     pub texture: (&'a Image, &'a Sampler),
-    pub constants: DiffuseSurfaceConstants,
+    pub constants: SurfaceConstants,
 }
 
 pub struct ShadePass {
-    /// The translucent objects' meshes to the G-buffer (depth, position, normal).
+    /// Every object's mesh to the G-buffer (depth, position, normal, texture).
     surface: Pipeline,
-    /// The opaque objects' meshes, with their reflectance.
-    surface_diffuse: Pipeline,
     /// Shading per variant and blending (additive for brute force in several draws), made on
     /// first use.
     shading: HashMap<(ShadeVariant, bool), Pipeline>,
@@ -205,8 +203,7 @@ fn surface_pipeline(ctx: &Context, vertex_shader: &str, fragment_shader: &str) -
 impl ShadePass {
     pub fn new(ctx: &Context) -> Result<ShadePass> {
         let surface = surface_pipeline(ctx, "surface.vert", "surface.frag")?;
-        let surface_diffuse = surface_pipeline(ctx, "surface_diffuse.vert", "surface_diffuse.frag")?;
-        Ok(ShadePass { surface, surface_diffuse, shading: HashMap::new() })
+        Ok(ShadePass { surface, shading: HashMap::new() })
     }
 
     /// Makes the shading pipeline of `variant` (and its additive twin for brute force) if not
@@ -221,40 +218,24 @@ impl ShadePass {
     }
 
     /// Clears the colour target and the work counters and rasterises every object's mesh into
-    /// the G-buffer: the translucent `objects` (position w = index + 1), then the `opaque` ones
-    /// (w = their id + 1, with their reflectance). Either may be empty.
-    pub fn record_surface(
-        &self,
-        rec: &mut Recorder,
-        targets: &SurfaceTargets,
-        objects: &[ShadeInputs],
-        opaque: &[OpaqueDraw],
-        constants: &ShadeConstants,
-    ) -> Result<()> {
+    /// the G-buffer, each with its id (position w = id + 1) and texture: the translucent objects
+    /// first, then the opaque ones (the frame lists them).
+    pub fn record_surface(&self, rec: &mut Recorder, targets: &SurfaceTargets, draws: &[SurfaceDraw]) -> Result<()> {
         rec.fill_buffer(targets.work, 0)?;
         rec.begin_rendering(&[(targets.color, Some([0.0; 4]))], None, 0)?;
         rec.end_rendering();
-        let translucent = objects.iter().map(|o| (o.vertices, o.indices));
-        for (vertices, indices) in translucent.chain(opaque.iter().map(|o| (o.vertices, o.indices))) {
-            rec.use_buffer(vertices, vk::Access::VERTEX_INPUT)?;
-            rec.use_buffer(indices, vk::Access::INDEX_INPUT)?;
-        }
-        for o in opaque {
+        for o in draws {
+            rec.use_buffer(o.vertices, vk::Access::VERTEX_INPUT)?;
+            rec.use_buffer(o.indices, vk::Access::INDEX_INPUT)?;
             rec.prepare_draw_reads(&[Bind::Read(o.uvs), Bind::Sampled(o.texture.0, o.texture.1)])?;
         }
         let clear = Some([0.0; 4]);
         let gbuffer = [(targets.position, clear), (targets.normal, clear), (targets.albedo, clear)];
         rec.begin_rendering(&gbuffer, Some((targets.depth, Some(1.0))), 0)?;
-        for (k, o) in objects.iter().enumerate() {
-            let mut c = *constants;
-            c.point_range.z = k as u32;
-            let (v, i) = (Some(o.vertices), Some(o.indices));
-            rec.draw(&self.surface, &[], vk::bytes_of(&c), v, i, o.index_count, 1)?;
-        }
-        for o in opaque {
+        for o in draws {
             let (v, i) = (Some(o.vertices), Some(o.indices));
             let binds = [Bind::Read(o.uvs), Bind::Sampled(o.texture.0, o.texture.1)];
-            rec.draw(&self.surface_diffuse, &binds, vk::bytes_of(&o.constants), v, i, o.index_count, 1)?;
+            rec.draw(&self.surface, &binds, vk::bytes_of(&o.constants), v, i, o.index_count, 1)?;
         }
         rec.end_rendering();
         Ok(())
@@ -289,6 +270,7 @@ impl ShadePass {
             Bind::Texels(inputs.point_flux),
             Bind::Texels(inputs.point_spread),
             Bind::Sampled(inputs.shadow_map, inputs.depth_sampler),
+            Bind::StorageImageRead(inputs.albedo),
         ];
         let mut c = *constants;
         c.point_range = glam::UVec4::new(unit.first_point, unit.point_count, unit.object, 0);

@@ -56,6 +56,9 @@ pub enum SubsurfaceSource {
     Coefficients,
     /// `reflectance` and `mfp`, inverted with the classical dipole ([`from_reflectance`]).
     Reflectance { reflectance: [f64; 3], mfp: [f64; 3] },
+    /// `"texture reflectance"` and `mfp`: the material is the texture's mean reflectance inverted,
+    /// and the texture weighs it per point (`world::Object::texture`).
+    Texture { texture: Reflectance, mfp: [f64; 3] },
     /// Nothing given: pbrt's default (its whole milk).
     Default,
 }
@@ -273,6 +276,14 @@ pub fn from_reflectance(
         sigma_a[ch] = (1.0 - alpha) * sigma_t_reduced;
     }
     Ok((sigma_a, sigma_s))
+}
+
+/// The largest reflectance [`from_reflectance`] inverts: the classical dipole's Rd at albedo 1.
+pub fn max_reflectance(eta: f64) -> f64 {
+    let a = crate::physics::Medium { sigma_a: 0.1, sigma_s: 1.0, g: 0.0, eta }
+        .constants(crate::physics::Diffusion::Classical)
+        .a_dipole;
+    crate::physics::dipole::total_rd(1.0, a)
 }
 
 /// Whether `flag` (`--width`) was typed on the command line `argv` (as `--width V` or
@@ -499,8 +510,38 @@ pub fn render_settings(
             material.sigma_a = material.sigma_a.map(|v| v * f);
             material.sigma_s = material.sigma_s.map(|v| v * f);
         }
-        let mut object = crate::world::Object::new(mesh_of(o)?.0, material);
+        let (mesh, uvs) = mesh_of(o)?;
+        let textured = match &sub.source {
+            SubsurfaceSource::Texture { texture, mfp } => Some((reflectance_of(texture, &sub.loc)?, mfp)),
+            _ => None,
+        };
+        if let Some((texture, mfp)) = &textured {
+            if uvs.is_none() {
+                return Err(bad_input!(
+                    "{}: Shape \"{}\": a reflectance texture needs the shape's \"point2 uv\"",
+                    o.loc,
+                    o.shape
+                ));
+            }
+            // The material is the texture's mean colour; the texture weighs it per point.
+            let typed = ["--material", "--sigma-a", "--sigma-s", "--g"].iter().any(|f| given(f));
+            if !typed {
+                let mean = texture.mean();
+                let top = max_reflectance(sub.eta) * 0.999;
+                let mean = [0, 1, 2].map(|c| (mean[c] as f64).min(top));
+                let (a, s) = from_reflectance(mean, **mfp, sub.g, sub.eta)
+                    .map_err(|why| bad_input!("{}: subsurface: {why}", sub.loc))?;
+                let f = sub.scale / mm_per_unit as f64;
+                (material.sigma_a, material.sigma_s) = (a.map(|v| v * f), s.map(|v| v * f));
+                material.g = [sub.g; 3];
+                material.validate()?;
+            }
+        }
+        let mut object = crate::world::Object::new(mesh, material);
         object.samples = args.samples;
+        if let Some((texture, _)) = textured {
+            (object.texture, object.uvs) = (Some(texture), uvs);
+        }
         objects.push(object);
     }
     let mut opaque_objects = Vec::new();
@@ -583,6 +624,7 @@ fn material_of(
         SubsurfaceSource::Named(n) => format!("{n} (pbrt-v4's table)"),
         SubsurfaceSource::Coefficients => format!("{} subsurface", sub.loc),
         SubsurfaceSource::Reflectance { .. } => format!("{} subsurface (from reflectance)", sub.loc),
+        SubsurfaceSource::Texture { .. } => format!("{} subsurface (from a reflectance texture)", sub.loc),
         SubsurfaceSource::Default => "pbrt-v4's default subsurface".into(),
     };
     mat.sigma_a = m.sigma_a.unwrap_or(mat.sigma_a);

@@ -431,7 +431,14 @@ impl Parser {
 
     fn material(&mut self, kind: &str, p: &ParamList, loc: &Loc) -> Result<MaterialDesc, String> {
         let m = match kind {
-            "subsurface" => MaterialDesc::Subsurface(subsurface(p, loc)?),
+            "subsurface" => {
+                // A textured reflectance: resolved here, inverted per point by the renderer.
+                let texture = match p.colour("reflectance", true)? {
+                    Some(ColourParam::Texture(_)) => Some(self.reflectance(p, "reflectance", [0.5; 3])?),
+                    _ => None,
+                };
+                MaterialDesc::Subsurface(subsurface(p, loc, texture)?)
+            }
             "diffuse" => MaterialDesc::Diffuse { reflectance: self.reflectance(p, "reflectance", [0.5; 3])? },
             "interface" | "" | "none" => MaterialDesc::Interface,
             other => {
@@ -642,8 +649,10 @@ impl Parser {
     }
 }
 
-/// pbrt-v4's `subsurface` material, in its four forms (see `SubsurfaceMaterial::Create`).
-fn subsurface(p: &ParamList, loc: &Loc) -> Result<Subsurface, String> {
+/// pbrt-v4's `subsurface` material, in its four forms (see `SubsurfaceMaterial::Create`);
+/// `texture`: the `reflectance` when it is a texture (its coefficients are then the texture's
+/// mean's, made when it is loaded: `pbrt::render_settings`).
+fn subsurface(p: &ParamList, loc: &Loc, texture: Option<Reflectance>) -> Result<Subsurface, String> {
     let mut g = p.float("g", 0.0)?;
     let scale = p.float("scale", 1.0)?;
     let eta = p.float("eta", 1.33)?;
@@ -675,14 +684,21 @@ fn subsurface(p: &ParamList, loc: &Loc) -> Result<Subsurface, String> {
             (Some(a), Some(s)) => (a, s, SubsurfaceSource::Coefficients),
             (Some(_), None) => return Err(err(loc, "subsurface: \"sigma_a\" given without \"sigma_s\"")),
             (None, Some(_)) => return Err(err(loc, "subsurface: \"sigma_s\" given without \"sigma_a\"")),
-            (None, None) => match colour("reflectance")? {
-                Some(r) => {
+            (None, None) => match (if texture.is_some() { None } else { colour("reflectance")? }, texture) {
+                (_, Some(texture)) => {
+                    let mfp = colour("mfp")?.unwrap_or([1.0; 3]);
+                    // Checked now at mid-grey; the texture's mean replaces it once loaded.
+                    let (a, s) = from_reflectance([0.5; 3], mfp, g, eta)
+                        .map_err(|why| err(loc, format!("subsurface: {why}")))?;
+                    (a, s, SubsurfaceSource::Texture { texture, mfp })
+                }
+                (Some(r), None) => {
                     let mfp = colour("mfp")?.unwrap_or([1.0; 3]);
                     let (a, s) =
                         from_reflectance(r, mfp, g, eta).map_err(|why| err(loc, format!("subsurface: {why}")))?;
                     (a, s, SubsurfaceSource::Reflectance { reflectance: r, mfp })
                 }
-                None => ([0.0011, 0.0024, 0.014], [2.55, 3.21, 3.77], SubsurfaceSource::Default),
+                (None, None) => ([0.0011, 0.0024, 0.014], [2.55, 3.21, 3.77], SubsurfaceSource::Default),
             },
         }
     };
