@@ -734,6 +734,91 @@ fn a_translucent_texture_is_carried_with_its_uvs_and_its_mean() {
     assert_eq!(out.status.code(), Some(0), "{}", common::stderr(&out));
 }
 
+/// A glTF material with a base colour texture and a pbrt-v4 `subsurface` with the same texture
+/// as its `"texture reflectance"` (and the same mean free path, η and mesh) make the same
+/// translucent object (material, texture, uvs) and, under the same typed camera and light, the
+/// same image bit for bit: the hand-off to the textured shading is the pbrt reader's.
+#[test]
+fn a_textured_gltf_material_is_pbrts_texture_reflectance() {
+    let d = dir("pbrt-twin");
+    let png = png_bytes(8, 4, |x, y| [40 + 25 * x as u8, 200 - 40 * y as u8, 90 + 10 * (x + y) as u8]);
+    std::fs::write(d.join("tex.png"), &png).unwrap();
+    let mut sphere = Mesh::sphere(0.5, 12);
+    // −0 as +0 (the glTF reader's f64 transform makes it so; normals are summed per position's bits).
+    sphere.positions.iter_mut().for_each(|p| *p += Vec3::ZERO);
+    // Dyadic uvs: exact in f32 through glTF's v turned twice.
+    let uvs: Vec<Vec2> =
+        (0..sphere.positions.len()).map(|k| Vec2::new((k % 8) as f32 / 8.0, (k % 5) as f32 / 8.0)).collect();
+    let flat = |v: &mut dyn Iterator<Item = f32>| v.map(|x| format!("{x}")).collect::<Vec<_>>().join(" ");
+    let pbrt = format!(
+        "Scale -1 1 1\nLookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 30\nWorldBegin\n\
+         Texture \"t\" \"spectrum\" \"imagemap\" \"string filename\" \"tex.png\"\n\
+         Material \"subsurface\" \"texture reflectance\" \"t\" \"rgb mfp\" [1 1 1] \"float eta\" 1.5 \"float scale\" 8\n\
+         Shape \"trianglemesh\" \"point3 P\" [{}] \"integer indices\" [{}] \"point2 uv\" [{}]\n",
+        flat(&mut sphere.positions.iter().flat_map(|p| p.to_array())),
+        sphere.indices.iter().map(|i| i.to_string()).collect::<Vec<_>>().join(" "),
+        flat(&mut uvs.iter().flat_map(|p| p.to_array())),
+    );
+    let pbrt_path = d.join("twin.pbrt");
+    std::fs::write(&pbrt_path, pbrt).unwrap();
+    let mut doc = Doc::new();
+    doc.json["images"] = json!([{"uri": "tex.png"}]);
+    doc.json["textures"] = json!([{"source": 0}]);
+    // mfp 1 mm at 8 mm per unit: an attenuation distance of 0.125, white.
+    let mat = doc.push(
+        "materials",
+        json!({"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}},
+               "extensions": {"KHR_materials_volume": {"attenuationDistance": 0.125},
+                              "KHR_materials_transmission": {"transmissionFactor": 1.0}}}),
+    );
+    let gl_uvs: Vec<Vec2> = uvs.iter().map(|uv| Vec2::new(uv.x, 1.0 - uv.y)).collect();
+    let m = doc.mesh(&sphere, Some(mat), Some(&gl_uvs));
+    doc.node(json!({"mesh": m}), true);
+    let gltf_path = doc.write_glb(&d, "twin");
+    let typed = [
+        "--scale",
+        "8",
+        "--eye",
+        "0,0.5,4",
+        "--target",
+        "0,0,0",
+        "--fov",
+        "30",
+        "--light",
+        "dir:0.3,0.5,-1:2",
+        "--width",
+        "40",
+        "--height",
+        "40",
+        "--roughness",
+        "0.4",
+    ];
+    let (a, b) = (settings_of(&pbrt_path, &typed).unwrap(), settings_of(&gltf_path, &typed).unwrap());
+    let (oa, ob) = (&a.world.objects[0], &b.world.objects[0]);
+    let diff = |x: &[Vec3], y: &[Vec3]| x.iter().zip(y).filter(|(a, b)| a != b).count() + x.len().abs_diff(y.len());
+    let (dp, dn) = (diff(&oa.mesh.positions, &ob.mesh.positions), diff(&oa.mesh.normals, &ob.mesh.normals));
+    let first = oa.mesh.normals.iter().zip(&ob.mesh.normals).position(|(a, b)| a != b);
+    assert!(
+        (dp, dn, oa.mesh.indices == ob.mesh.indices) == (0, 0, true),
+        "positions {dp}, normals {dn} differ (first {first:?}: {:?}), indices equal: {}",
+        first.map(|k| (oa.mesh.normals[k], ob.mesh.normals[k])),
+        oa.mesh.indices == ob.mesh.indices
+    );
+    assert_eq!((oa.uvs.as_ref(), oa.texture.as_ref()), (ob.uvs.as_ref(), ob.texture.as_ref()));
+    assert!(oa.texture.is_some());
+    let (ma, mb) = (&oa.material, &ob.material);
+    assert_eq!((ma.sigma_a, ma.sigma_s, ma.g, ma.eta), (mb.sigma_a, mb.sigma_s, mb.g, mb.eta), "{ma:?} vs {mb:?}");
+    assert_eq!(a.world.mm_per_unit, b.world.mm_per_unit);
+    let (ia, ib) = (d.join("pbrt.exr"), d.join("gltf.exr"));
+    for (path, out) in [(&pbrt_path, &ia), (&gltf_path, &ib)] {
+        let o = render(&[&[path.to_str().unwrap(), "--validation", "-o", out.to_str().unwrap()][..], &typed].concat());
+        assert_eq!(o.status.code(), Some(0), "{}", common::stderr(&o));
+    }
+    let (ia, ib) = (exr(&ia), exr(&ib));
+    assert!(ia.pixels().filter(|p| p[3] > 0.0).count() > 150, "the sphere is in view");
+    assert!(ia == ib, "the glTF twin renders differently from the pbrt scene");
+}
+
 /// glTF's metres: a 0.1 m bunny is 100 mm across at 1000 mm per unit (`--scale` replaces it),
 /// framed by the default camera when the file has none, under the default light.
 #[test]

@@ -129,7 +129,8 @@ impl MaterialDesc {
     pub fn reflectance(&self) -> [f64; 3] {
         match (&self.multiscatter, &self.texture) {
             (Some(c), _) => *c,
-            (None, Some(t)) => t.mean(),
+            // As a pbrt scene's texture reflectance takes it (`Reflectance::mean`, in f32).
+            (None, Some(t)) => t.mean().map(|c| c as f32 as f64),
             (None, None) => self.base_color,
         }
     }
@@ -204,13 +205,8 @@ fn material_of(
             let mfp =
                 desc.mfp().ok_or_else(|| bad_input!("{shown}: {}: no attenuation distance or thickness", desc.path))?;
             let mfp_mm = mfp.map(|l| l * mm_per_unit as f64);
-            let top = {
-                // The largest reflectance the dipole reaches for this η (from_reflectance refuses it).
-                let a = crate::physics::Medium { sigma_a: 0.1, sigma_s: 1.0, g: 0.0, eta: desc.ior }
-                    .constants(crate::physics::Diffusion::Classical)
-                    .a_dipole;
-                crate::physics::dipole::total_rd(1.0, a)
-            };
+            // The largest reflectance the dipole reaches for this η (from_reflectance refuses it).
+            let top = crate::pbrt::max_reflectance(desc.ior);
             let wanted = desc.reflectance();
             let reflectance = wanted.map(|r| r.min(top * 0.999));
             if reflectance != wanted {
