@@ -433,6 +433,16 @@ fn a_node_hierarchy_matches_meshes_transformed_by_hand() {
     assert!(
         scene.objects[2].path.starts_with("nodes[0] ") && scene.objects[2].path.contains("meshes[0].primitives[0]")
     );
+    // The World render draws: the same triangles (opaque, glTF's default material), in its units.
+    let s = settings_of(&d.join("h.gltf"), &[]).unwrap();
+    assert_eq!(s.world.opaque.len(), 4);
+    let f = 1000.0 / s.world.mm_per_unit;
+    for (o, w) in scene.objects.iter().zip(&s.world.opaque) {
+        assert_eq!(o.mesh.indices, w.mesh.indices, "{}", o.path);
+        for (p, q) in o.mesh.positions.iter().zip(&w.mesh.positions) {
+            assert!((*p * f - *q).length() < 1e-6 * f, "{}: {p} vs {q}", o.path);
+        }
+    }
 }
 
 /// Strips and fans become the triangles the specification forms; a mesh's several primitives,
@@ -1273,53 +1283,191 @@ proptest! {
 
 }
 
+/// A scene with something of everything (meshes, a texture, lights, a camera), as fuzzing starts.
+fn fuzz_doc() -> Doc {
+    let mut doc = triangle();
+    box_scene(&mut doc, json!({"index": 0}));
+    doc.json["images"] = json!([{"uri": "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAIAAACQd1PeAAAADElEQVR4nGP4//8/AAX+Av4N70a4AAAAAElFTkSuQmCC"}]);
+    doc.json["textures"] = json!([{"source": 0}]);
+    doc
+}
+
+/// An edit of the JSON tree: the `n`th number replaced, or the `n`th value (any) removed from
+/// its object or array.
+#[derive(Clone, Debug)]
+enum JsonEdit {
+    Number(prop::sample::Index, Value),
+    Remove(prop::sample::Index),
+}
+
+fn json_edits() -> impl Strategy<Value = Vec<JsonEdit>> {
+    let value = prop_oneof![
+        Just(json!(0)),
+        Just(json!(1)),
+        Just(json!(-1)),
+        Just(json!(3)),
+        Just(json!(4)),
+        Just(json!(255)),
+        Just(json!(5121)),
+        Just(json!(5126)),
+        Just(json!(4294967295u64)),
+        Just(json!(1u64 << 40)),
+        Just(json!(1e30)),
+        Just(json!(-1e30)),
+        Just(json!(0.5)),
+        Just(json!(1e-30)),
+        Just(json!(18446744073709551615u64)),
+        Just(json!("VEC3")),
+        Just(json!([])),
+        Just(json!({})),
+    ];
+    let edit = prop_oneof![
+        4 => (any::<prop::sample::Index>(), value).prop_map(|(i, v)| JsonEdit::Number(i, v)),
+        1 => any::<prop::sample::Index>().prop_map(JsonEdit::Remove),
+    ];
+    proptest::collection::vec(edit, 1..5)
+}
+
+fn count_values(v: &Value) -> usize {
+    1 + match v {
+        Value::Array(a) => a.iter().map(count_values).sum(),
+        Value::Object(o) => o.values().map(count_values).sum(),
+        _ => 0,
+    }
+}
+
+/// Removes the `n`th value below the root, depth first (`true` when done).
+fn remove_nth(v: &mut Value, n: &mut usize) -> bool {
+    match v {
+        Value::Array(a) => {
+            for k in 0..a.len() {
+                if *n == 0 {
+                    a.remove(k);
+                    return true;
+                }
+                *n -= 1;
+                if remove_nth(&mut a[k], n) {
+                    return true;
+                }
+            }
+            false
+        }
+        Value::Object(o) => {
+            let keys: Vec<String> = o.keys().cloned().collect();
+            for k in keys {
+                if *n == 0 {
+                    o.remove(&k);
+                    return true;
+                }
+                *n -= 1;
+                if remove_nth(o.get_mut(&k).unwrap(), n) {
+                    return true;
+                }
+            }
+            false
+        }
+        _ => false,
+    }
+}
+
+/// The whole reader on the fuzzing scene with its JSON edited: a result or a refusal, never a panic.
+fn check_json_edits(edits: Vec<JsonEdit>) {
+    let d = dir("numbers");
+    let mut doc = fuzz_doc();
+    for edit in edits {
+        match edit {
+            JsonEdit::Number(at, new) => {
+                let count = count_numbers(&doc.json);
+                if let Some(v) = nth_number(&mut doc.json, &mut at.index(count)) {
+                    *v = new;
+                }
+            }
+            JsonEdit::Remove(at) => {
+                let count = count_values(&doc.json) - 1;
+                remove_nth(&mut doc.json, &mut at.index(count.max(1)));
+            }
+        }
+    }
+    let path = doc.write_glb(&d, "n");
+    let _ = tg::load(&path, None);
+    let _ = settings_of(&path, &[]);
+}
+
+/// The whole reader on the fuzzing scene (GLB, or `.gltf` with a data URI) with bytes changed.
+fn check_byte_edits(edits: Vec<(prop::sample::Index, u8)>, glb_form: bool) {
+    use base64::Engine;
+    let d = dir("fuzz");
+    let doc = fuzz_doc();
+    let mut bytes = if glb_form {
+        glb(&serde_json::to_vec(&doc.json).unwrap(), &doc.bin)
+    } else {
+        let mut j = doc.json.clone();
+        let data = base64::engine::general_purpose::STANDARD.encode(&doc.bin);
+        j["buffers"][0]["uri"] = json!(format!("data:application/octet-stream;base64,{data}"));
+        serde_json::to_vec(&j).unwrap()
+    };
+    for (at, b) in edits {
+        let i = at.index(bytes.len());
+        bytes[i] = b;
+    }
+    let path = d.join(if glb_form { "f.glb" } else { "f.gltf" });
+    std::fs::write(&path, &bytes).unwrap();
+    let _ = tg::load(&path, None);
+    let _ = settings_of(&path, &[]);
+}
+
+fn byte_edits() -> impl Strategy<Value = (Vec<(prop::sample::Index, u8)>, bool)> {
+    (proptest::collection::vec((any::<prop::sample::Index>(), any::<u8>()), 1..6), any::<bool>())
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 1000, ..ProptestConfig::default() })]
 
-    /// The whole reader on a valid file with numbers of its JSON changed (counts, offsets,
-    /// strides, indices, factors) to values a file may hold: a result or a refusal, never a panic.
+    /// The whole reader on a valid file with its JSON edited (numbers changed to values a file
+    /// may hold: counts, offsets, strides, indices, factors; values removed).
     #[test]
-    fn the_reader_never_panics_on_changed_numbers(edits in proptest::collection::vec((any::<prop::sample::Index>(), prop_oneof![
-        Just(json!(0)), Just(json!(1)), Just(json!(-1)), Just(json!(3)), Just(json!(4)), Just(json!(255)), Just(json!(5121)),
-        Just(json!(5126)), Just(json!(4294967295u64)), Just(json!(1u64 << 40)), Just(json!(1e30)), Just(json!(-1e30)),
-        Just(json!(0.5)), Just(json!(1e-30)), Just(json!(18446744073709551615u64)), Just(json!("VEC3")), Just(json!([]))]), 1..5)) {
-        let d = dir("numbers");
-        let mut doc = triangle();
-        box_scene(&mut doc, json!({"index": 0}));
-        doc.json["images"] = json!([{"uri": "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAIAAACQd1PeAAAADElEQVR4nGP4//8/AAX+Av4N70a4AAAAAElFTkSuQmCC"}]);
-        doc.json["textures"] = json!([{"source": 0}]);
-        for (at, new) in edits {
-            let count = count_numbers(&doc.json);
-            if let Some(v) = nth_number(&mut doc.json, &mut at.index(count)) {
-                *v = new;
-            }
-        }
-        let path = doc.write_glb(&d, "n");
-        let _ = tg::load(&path, None);
-        let _ = settings_of(&path, &[]);
+    fn the_reader_never_panics_on_an_edited_json(edits in json_edits()) {
+        check_json_edits(edits);
     }
 
     /// The whole reader on a valid file with bytes changed: a result or a refusal, never a panic.
     #[test]
-    fn the_reader_never_panics_on_a_damaged_file(edits in proptest::collection::vec((any::<prop::sample::Index>(), any::<u8>()), 1..6), glb_form in any::<bool>()) {
-        let d = dir("fuzz");
-        let mut doc = triangle();
-        box_scene(&mut doc, json!({"index": 0}));
-        doc.json["images"] = json!([{"uri": "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAIAAACQd1PeAAAADElEQVR4nGP4//8/AAX+Av4N70a4AAAAAElFTkSuQmCC"}]);
-        doc.json["textures"] = json!([{"source": 0}]);
-        let mut bytes = if glb_form { glb(&serde_json::to_vec(&doc.json).unwrap(), &doc.bin) } else {
-            let mut j = doc.json.clone();
-            use base64::Engine;
-            j["buffers"][0]["uri"] = json!(format!("data:application/octet-stream;base64,{}", base64::engine::general_purpose::STANDARD.encode(&doc.bin)));
-            serde_json::to_vec(&j).unwrap()
-        };
-        for (at, b) in edits {
-            let i = at.index(bytes.len());
-            bytes[i] = b;
+    fn the_reader_never_panics_on_a_damaged_file((edits, glb_form) in byte_edits()) {
+        check_byte_edits(edits, glb_form);
+    }
+}
+
+/// `scripts/fuzz`: the two whole-reader properties for FUZZ_SECONDS each (default 60).
+#[test]
+#[ignore]
+fn fuzz_gltf_reader() {
+    use proptest::test_runner::{Config, TestRunner};
+    let seconds: u64 = std::env::var("FUZZ_SECONDS").ok().and_then(|s| s.parse().ok()).unwrap_or(60);
+    for (name, edits) in [("JSON edits", true), ("byte edits", false)] {
+        let start = std::time::Instant::now();
+        let mut total = 0u64;
+        while start.elapsed().as_secs() < seconds {
+            let mut runner = TestRunner::new(Config { cases: 256, failure_persistence: None, ..Config::default() });
+            let outcome = if edits {
+                runner
+                    .run(&json_edits(), |e| {
+                        check_json_edits(e);
+                        Ok(())
+                    })
+                    .map_err(|e| e.to_string())
+            } else {
+                runner
+                    .run(&byte_edits(), |(e, g)| {
+                        check_byte_edits(e, g);
+                        Ok(())
+                    })
+                    .map_err(|e| e.to_string())
+            };
+            if let Err(e) = outcome {
+                panic!("fuzz glTF reader ({name}): {e}");
+            }
+            total += 256;
         }
-        let path = d.join(if glb_form { "f.glb" } else { "f.gltf" });
-        std::fs::write(&path, &bytes).unwrap();
-        let _ = tg::load(&path, None);
-        let _ = settings_of(&path, &[]);
+        println!("fuzz glTF reader ({name}): {total} inputs in {:.0} s, no failure", start.elapsed().as_secs_f64());
     }
 }
