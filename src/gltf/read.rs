@@ -129,6 +129,11 @@ pub fn load(path: &Path, scene: Option<usize>) -> Result<GltfScene> {
         elements: [0; 2],
     };
     reader.read_scene(scene)?;
+    let unread: Vec<&str> =
+        root.extensions_used.iter().map(String::as_str).filter(|e| !SUPPORTED_EXTENSIONS.contains(e)).collect();
+    if !unread.is_empty() {
+        reader.warn("extensionsUsed", format!("{}: not read (the scene is rendered without them)", unread.join(", ")));
+    }
     reader.scene.material_names = root.materials.iter().filter_map(|m| m.name.clone()).collect();
     Ok(reader.scene)
 }
