@@ -59,7 +59,7 @@ pub(super) fn mitsuba(args: &MitsubaArgs) -> Result<i32> {
         // A texture: the medium's albedo as a volume (its nearest surface point's colour).
         let surface = match (&o.texture, &o.uvs) {
             (Some(texture), Some(uvs)) => {
-                let albedo = mitsuba::albedo_grid(mesh, uvs, texture, &medium, mm as f64, 128)?;
+                let albedo = mitsuba::albedo_grid(mesh, uvs, texture, &medium, mm, 128)?;
                 Surface::TexturedTranslucent { medium, albedo }
             }
             _ => Surface::Translucent(medium),
