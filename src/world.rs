@@ -86,6 +86,38 @@ pub enum Reflectance {
 }
 
 impl Reflectance {
+    /// The value at `uv`, as the GPU reads it (shaders/include/surface_texture.glsl): a
+    /// checkerboard by the parity of ⌊u·uscale⌋ + ⌊v·vscale⌋, an image with v running up it,
+    /// repeated, filtered linearly between texel centres.
+    pub fn at(&self, uv: Vec2) -> Vec3 {
+        match self {
+            Reflectance::Constant(c) => *c,
+            Reflectance::Checkerboard { uscale, vscale, tex1, tex2 } => {
+                let parity = (uv.x * uscale).floor() as i64 + (uv.y * vscale).floor() as i64;
+                if parity.rem_euclid(2) == 0 {
+                    *tex1
+                } else {
+                    *tex2
+                }
+            }
+            Reflectance::Image(t) => {
+                let (w, h) = (t.width as i64, t.height as i64);
+                let x = uv.x * w as f32 - 0.5;
+                let y = (1.0 - uv.y) * h as f32 - 0.5;
+                let (x0, y0) = (x.floor(), y.floor());
+                let (fx, fy) = (x - x0, y - y0);
+                let texel = |i: i64, j: i64| {
+                    let p = t.texels[(j.rem_euclid(h) * w + i.rem_euclid(w)) as usize];
+                    Vec3::new(p[0], p[1], p[2])
+                };
+                let (i, j) = (x0 as i64, y0 as i64);
+                let top = texel(i, j).lerp(texel(i + 1, j), fx);
+                let bottom = texel(i, j + 1).lerp(texel(i + 1, j + 1), fx);
+                top.lerp(bottom, fy)
+            }
+        }
+    }
+
     /// The mean over the surface's uv square: a checkerboard's two values equally, an image's
     /// texels (summed in f64).
     pub fn mean(&self) -> Vec3 {

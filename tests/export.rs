@@ -364,3 +364,55 @@ fn environments_are_exported_whole() {
     assert!(img.get_pixel(x, y)[0] > 100.0, "{:?}", img.get_pixel(x, y));
     assert!(img.get_pixel(img.width() * 3 / 4, y)[0] < 1.0);
 }
+
+/// A textured translucent object is a heterogeneous medium: its albedo a grid over the mesh's box
+/// whose voxels hold the texture at their nearest surface point inverted to α' (the reduced
+/// albedo whose classical-dipole Rd is that colour, with the material's mean free path), its σt
+/// one voxel over the same box (the reduced σ't: g = 0).
+#[test]
+fn a_textured_object_is_a_heterogeneous_medium_of_its_colours() {
+    use glam::Vec2;
+    use translucent::export::mitsuba::albedo_grid;
+    use translucent::world::Reflectance;
+    let mesh = Mesh::slab(100.0, 100.0, 20.0);
+    let uvs: Vec<Vec2> = mesh.positions.iter().map(|p| Vec2::new((p.x / 100.0 + 0.5) * 1.9999, 0.0)).collect();
+    let (bright, dark) = (Vec3::new(0.62, 0.42, 0.30), Vec3::new(0.25, 0.12, 0.06));
+    let texture = Reflectance::Checkerboard { uscale: 1.0, vscale: 0.0, tex1: bright, tex2: dark };
+    let skin = Material::find("skin1").unwrap();
+    let medium = Medium { sigma_a: skin.sigma_a, sigma_s: skin.sigma_s, g: skin.g, eta: skin.eta };
+    let grid = albedo_grid(&mesh, &uvs, &texture, &medium, 2.0, 32).unwrap();
+    assert_eq!(grid.resolution, [32, 7, 32]);
+    assert_eq!((grid.lo, grid.hi), (DVec3::new(-100.0, -20.0, -100.0), DVec3::new(100.0, 20.0, 100.0)));
+    let at = |x: usize| grid.albedo[(16 * 7 + 3) * 32 + x];
+    for (x, colour) in [(4, bright), (27, dark)] {
+        // The material of that colour, with Skin1's mean free path: its α' is the voxel's.
+        let own = skin.with_reflectance(colour.as_dvec3().to_array()).unwrap();
+        for c in 0..3 {
+            let m = own.channel(c);
+            let alpha = m.sigma_s * (1.0 - m.g) / (m.sigma_a + m.sigma_s * (1.0 - m.g));
+            assert!((at(x)[c] as f64 - alpha).abs() < 2e-3, "voxel {x} channel {c}: {:?} against {alpha}", at(x));
+        }
+    }
+    // Written: a heterogeneous medium with both volumes, each file a version 3 float grid.
+    let dir = output_dir().join("export-textured");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let object = Object {
+        name: "slab".into(),
+        mesh: &mesh,
+        mm_per_unit: 2.0,
+        surface: Surface::TexturedTranslucent { medium, albedo: grid },
+    };
+    let camera = Camera { eye: DVec3::new(0.0, 500.0, 0.0), target: DVec3::ZERO, up: DVec3::Z, fov_y_deg: 30.0 };
+    let light = Light::Directional { toward: DVec3::Y, irradiance: [1.0; 3] };
+    write_scene(&dir, &camera, (&[light], None), &[object], &Options::default()).unwrap();
+    let xml = std::fs::read_to_string(dir.join("scene.xml")).unwrap();
+    assert!(xml.contains("<medium type=\"heterogeneous\""), "{xml}");
+    for name in ["sigma_t", "albedo"] {
+        assert!(xml.contains(&format!("<volume name=\"{name}\" type=\"gridvolume\">")), "{xml}");
+        let bytes = std::fs::read(dir.join(format!("object0-{name}.vol"))).unwrap();
+        assert_eq!(&bytes[..4], b"VOL\x03");
+        let count: i32 = (0..3).map(|k| i32::from_le_bytes(bytes[8 + 4 * k..12 + 4 * k].try_into().unwrap())).product();
+        assert_eq!(bytes.len(), 48 + count as usize * 12, "{name}");
+    }
+}

@@ -52,20 +52,20 @@ pub(super) fn mitsuba(args: &MitsubaArgs) -> Result<i32> {
     let explicit = &desc.lights[..desc.lights.len().saturating_sub(sampled)];
     let lights: Vec<Light> = explicit.iter().map(|l| light_in_mm(l, mm)).collect();
     let meshes: Vec<_> = world.objects.iter().map(|o| o.world_mesh()).collect();
-    let objects: Vec<Object> = world
-        .objects
-        .iter()
-        .zip(&meshes)
-        .map(|(o, mesh)| {
-            let m = &o.material;
-            Object {
-                name: m.name.clone(),
-                mesh,
-                mm_per_unit: mm,
-                surface: Surface::Translucent(Medium { sigma_a: m.sigma_a, sigma_s: m.sigma_s, g: m.g, eta: m.eta }),
+    let mut objects: Vec<Object> = Vec::new();
+    for (o, mesh) in world.objects.iter().zip(&meshes) {
+        let m = &o.material;
+        let medium = Medium { sigma_a: m.sigma_a, sigma_s: m.sigma_s, g: m.g, eta: m.eta };
+        // A texture: the medium's albedo as a volume (its nearest surface point's colour).
+        let surface = match (&o.texture, &o.uvs) {
+            (Some(texture), Some(uvs)) => {
+                let albedo = mitsuba::albedo_grid(mesh, uvs, texture, &medium, mm, 128)?;
+                Surface::TexturedTranslucent { medium, albedo }
             }
-        })
-        .collect();
+            _ => Surface::Translucent(medium),
+        };
+        objects.push(Object { name: m.name.clone(), mesh, mm_per_unit: mm, surface });
+    }
     let m = &world.objects[0].material;
     let options = Options {
         width: desc.width,

@@ -75,6 +75,9 @@ pub struct Medium {
 pub enum Surface {
     /// A smooth dielectric boundary of the medium's η around the medium.
     Translucent(Medium),
+    /// The same around a `heterogeneous` medium: σt the medium's (similarity-reduced, g = 0),
+    /// the single-scattering albedo per voxel of `albedo` (a textured material, [`albedo_grid`]).
+    TexturedTranslucent { medium: Medium, albedo: AlbedoGrid },
     /// An opaque Lambertian surface.
     Diffuse { reflectance: [f64; 3] },
 }
@@ -106,6 +109,172 @@ impl Default for Options {
     fn default() -> Self {
         Options { width: 512, height: 512, spp: 256, light_radius_deg: 5.0, max_depth: -1, rr_depth: None }
     }
+}
+
+/// A single-scattering albedo per voxel over a box in mm (x fastest, then y, then z), written as
+/// Mitsuba's `gridvolume` (.vol) for a textured material's medium (and, one voxel, its σt).
+#[derive(Clone, Debug, PartialEq)]
+pub struct AlbedoGrid {
+    pub lo: DVec3,
+    pub hi: DVec3,
+    pub resolution: [u32; 3],
+    pub albedo: Vec<[f32; 3]>,
+}
+
+/// The most voxels × triangles [`albedo_grid`] searches (its nearest-point search is exhaustive).
+pub const ALBEDO_GRID_WORK: u64 = 4_000_000_000;
+
+/// A textured translucent object's medium as a volume: each voxel of a grid over the mesh's box
+/// (at most `max_side` voxels along its longest side, fewer where the mesh has many triangles)
+/// takes the texture's reflectance at its nearest surface point's uv, inverted to the reduced
+/// albedo α' with the material's mean free path (as the renderer's weight does: the classical
+/// dipole's Rd), written similarity-reduced (g = 0, so σt = σ't is the same everywhere and only
+/// the albedo varies). The texture lives on the surface; the volume extends it inward from the
+/// nearest surface point, the one choice that is the same texture seen from outside.
+pub fn albedo_grid(
+    mesh: &Mesh,
+    uvs: &[glam::Vec2],
+    texture: &crate::world::Reflectance,
+    medium: &Medium,
+    mm_per_unit: f64,
+    max_side: u32,
+) -> Result<AlbedoGrid> {
+    let triangles = mesh.indices.len() as u64 / 3;
+    if uvs.len() != mesh.positions.len() || triangles == 0 {
+        return Err(bad_input!("export: a textured object needs one uv per vertex and a triangle"));
+    }
+    let (lo, hi) = mesh.bounds();
+    let (lo, hi) = (lo.as_dvec3(), hi.as_dvec3());
+    let extent = (hi - lo).max(DVec3::splat(1e-9 * (hi - lo).max_element().max(1e-30)));
+    let mut side = max_side.max(1);
+    let res_of = |side: u32| extent.to_array().map(|e| ((e / extent.max_element() * side as f64).ceil() as u32).max(1));
+    while side > 8 && res_of(side).iter().map(|&r| r as u64).product::<u64>() * triangles > ALBEDO_GRID_WORK {
+        side = side * 3 / 4;
+    }
+    let resolution = res_of(side);
+    if resolution.iter().map(|&r| r as u64).product::<u64>() * triangles > ALBEDO_GRID_WORK {
+        return Err(bad_input!(
+            "export: {triangles} triangles are too many to write the object's texture as a volume (a grid of at least 8 voxels a side)"
+        ));
+    }
+    // α'(ρ) per channel by the classical dipole's Rd, on a table of α' (Rd rises monotonically).
+    let inverse = [0, 1, 2].map(|c| {
+        let m = crate::physics::Medium {
+            sigma_a: medium.sigma_a[c],
+            sigma_s: medium.sigma_s[c],
+            g: medium.g[c],
+            eta: medium.eta,
+        };
+        let a = m.constants(crate::physics::Diffusion::Classical).a_dipole;
+        (0..=4096)
+            .map(|k| (crate::physics::dipole::total_rd(k as f64 / 4096.0, a), k as f64 / 4096.0))
+            .collect::<Vec<_>>()
+    });
+    let alpha_of = |c: usize, rho: f64| -> f64 {
+        let t = &inverse[c];
+        let k = t.partition_point(|&(rd, _)| rd < rho);
+        match k {
+            0 => 0.0,
+            k if k >= t.len() => 1.0,
+            k => {
+                let ((r0, a0), (r1, a1)) = (t[k - 1], t[k]);
+                a0 + (a1 - a0) * (rho - r0) / (r1 - r0).max(f64::MIN_POSITIVE)
+            }
+        }
+    };
+    let [nx, ny, nz] = resolution;
+    let mut albedo = Vec::with_capacity((nx * ny * nz) as usize);
+    for z in 0..nz {
+        for y in 0..ny {
+            for x in 0..nx {
+                let p = lo
+                    + extent * DVec3::new(x as f64 + 0.5, y as f64 + 0.5, z as f64 + 0.5)
+                        / DVec3::new(nx as f64, ny as f64, nz as f64);
+                let uv = nearest_uv(mesh, uvs, p);
+                let rho = texture.at(uv);
+                albedo.push([0, 1, 2].map(|c| alpha_of(c, rho[c] as f64) as f32));
+            }
+        }
+    }
+    let mm = mm_per_unit;
+    Ok(AlbedoGrid { lo: lo * mm, hi: (lo + extent) * mm, resolution, albedo })
+}
+
+/// The uv at the point of `mesh` nearest to `p` (every triangle tried).
+fn nearest_uv(mesh: &Mesh, uvs: &[glam::Vec2], p: DVec3) -> glam::Vec2 {
+    let mut best = (f64::MAX, glam::Vec2::ZERO);
+    for t in mesh.indices.chunks_exact(3) {
+        let [a, b, c] = [0, 1, 2].map(|k| mesh.positions[t[k] as usize].as_dvec3());
+        let (u, v, w) = closest_on_triangle(p, a, b, c);
+        let q = a * u + b * v + c * w;
+        let d = (q - p).length_squared();
+        if d < best.0 {
+            let uv = uvs[t[0] as usize] * u as f32 + uvs[t[1] as usize] * v as f32 + uvs[t[2] as usize] * w as f32;
+            best = (d, uv);
+        }
+    }
+    best.1
+}
+
+/// The barycentrics of the point of triangle abc nearest to p (Ericson, Real-Time Collision
+/// Detection, 5.1.5).
+fn closest_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> (f64, f64, f64) {
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return (1.0, 0.0, 0.0);
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return (0.0, 1.0, 0.0);
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        let v = d1 / (d1 - d3);
+        return (1.0 - v, v, 0.0);
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return (0.0, 0.0, 1.0);
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        let w = d2 / (d2 - d6);
+        return (1.0 - w, 0.0, w);
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return (0.0, 1.0 - w, w);
+    }
+    let denom = 1.0 / (va + vb + vc);
+    let (v, w) = (vb * denom, vc * denom);
+    if !(v.is_finite() && w.is_finite()) {
+        return (1.0, 0.0, 0.0); // a degenerate triangle: its first corner
+    }
+    (1.0 - v - w, v, w)
+}
+
+/// Mitsuba's `.vol` grid (format version 3, float32, `channels` per voxel, the box in mm).
+fn write_vol(path: &Path, grid: &AlbedoGrid) -> Result<()> {
+    let mut bytes = Vec::with_capacity(48 + grid.albedo.len() * 12);
+    bytes.extend_from_slice(b"VOL\x03");
+    bytes.extend_from_slice(&1i32.to_le_bytes());
+    for r in grid.resolution {
+        bytes.extend_from_slice(&(r as i32).to_le_bytes());
+    }
+    bytes.extend_from_slice(&3i32.to_le_bytes());
+    for v in [grid.lo.x, grid.lo.y, grid.lo.z, grid.hi.x, grid.hi.y, grid.hi.z] {
+        bytes.extend_from_slice(&(v as f32).to_le_bytes());
+    }
+    for a in &grid.albedo {
+        for c in a {
+            bytes.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    crate::output::write_file(path, &bytes)
 }
 
 /// What Mitsuba's `homogeneous` medium is given: σt normalised to [0, 1] with its largest channel
@@ -284,15 +453,46 @@ pub fn write_scene(
         written.meshes.push(path);
         let _ = writeln!(w, "    <!-- {} -->", xml_comment(&o.name));
         match &o.surface {
-            Surface::Translucent(m) => {
-                let h = homogeneous(m);
+            Surface::Translucent(_) | Surface::TexturedTranslucent { .. } => {
+                let (m, grid) = match &o.surface {
+                    Surface::TexturedTranslucent { medium, albedo } => (medium, Some(albedo)),
+                    Surface::Translucent(m) => (m, None),
+                    Surface::Diffuse { .. } => unreachable!("matched above"),
+                };
+                let mut h = homogeneous(m);
                 if let Some(warning) = &h.warning {
                     written.warnings.push(format!("{}: {warning}", o.name));
                 }
-                let _ = writeln!(w, "    <medium type=\"homogeneous\" id=\"medium{i}\">");
-                let _ = writeln!(w, "        <rgb name=\"sigma_t\" value=\"{}\"/>", triple(h.sigma_t));
-                let _ = writeln!(w, "        <float name=\"scale\" value=\"{}\"/>", num(h.scale));
-                let _ = writeln!(w, "        <rgb name=\"albedo\" value=\"{}\"/>", triple(h.albedo));
+                if let Some(grid) = grid {
+                    // Similarity-reduced, so that σt is the same in every voxel.
+                    let reduced: [f64; 3] = std::array::from_fn(|c| m.sigma_a[c] + m.sigma_s[c] * (1.0 - m.g[c]));
+                    let scale = reduced.iter().cloned().fold(0.0, f64::max).max(f64::MIN_POSITIVE);
+                    (h.sigma_t, h.scale, h.g) = (reduced.map(|v| v / scale), scale, None);
+                    // σt as a grid of one voxel over the same box: Mitsuba 3.9's heterogeneous
+                    // medium takes its extent from σt's volume, and a constant one has none (the
+                    // medium rendered black).
+                    let sigma_t =
+                        AlbedoGrid { resolution: [1, 1, 1], albedo: vec![h.sigma_t.map(|v| v as f32)], ..grid.clone() };
+                    let _ = writeln!(w, "    <medium type=\"heterogeneous\" id=\"medium{i}\">");
+                    let _ = writeln!(w, "        <float name=\"scale\" value=\"{}\"/>", num(h.scale));
+                    for (name, volume) in [("sigma_t", &sigma_t), ("albedo", grid)] {
+                        let vol = format!("object{i}-{name}.vol");
+                        write_vol(&dir.join(&vol), volume)?;
+                        written.meshes.push(dir.join(&vol));
+                        let _ = writeln!(w, "        <volume name=\"{name}\" type=\"gridvolume\">");
+                        let _ = writeln!(w, "            <string name=\"filename\" value=\"{vol}\"/>");
+                        let _ = writeln!(w, "            <transform name=\"to_world\">");
+                        let _ = writeln!(w, "                <scale value=\"{}\"/>", triple(dv(grid.hi - grid.lo)));
+                        let _ = writeln!(w, "                <translate value=\"{}\"/>", triple(dv(grid.lo)));
+                        let _ = writeln!(w, "            </transform>");
+                        let _ = writeln!(w, "        </volume>");
+                    }
+                } else {
+                    let _ = writeln!(w, "    <medium type=\"homogeneous\" id=\"medium{i}\">");
+                    let _ = writeln!(w, "        <rgb name=\"sigma_t\" value=\"{}\"/>", triple(h.sigma_t));
+                    let _ = writeln!(w, "        <float name=\"scale\" value=\"{}\"/>", num(h.scale));
+                    let _ = writeln!(w, "        <rgb name=\"albedo\" value=\"{}\"/>", triple(h.albedo));
+                }
                 match h.g {
                     Some(g) => {
                         let _ =
