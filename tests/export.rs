@@ -416,3 +416,28 @@ fn a_textured_object_is_a_heterogeneous_medium_of_its_colours() {
         assert_eq!(bytes.len(), 48 + count as usize * 12, "{name}");
     }
 }
+
+/// A scene file is exported as `render` reads it (its camera, its translucent and opaque shapes),
+/// not the default bunny: a pbrt-v4 box of Skin1 on a grey floor.
+#[test]
+fn a_scene_file_is_exported_as_render_reads_it() {
+    let dir = output_dir().join("export-scene-file");
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = dir.join("scene.pbrt");
+    std::fs::write(
+        &scene,
+        "LookAt 0 3 6  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 30\n\
+         Film \"rgb\" \"integer xresolution\" 64 \"integer yresolution\" 48\nWorldBegin\n\
+         LightSource \"distant\" \"point3 from\" [0 1 0] \"point3 to\" [0 0 0]\n\
+         Material \"subsurface\" \"string name\" \"Skin1\" \"float scale\" 10\n\
+         Shape \"sphere\" \"float radius\" 1\n\
+         Material \"diffuse\" \"rgb reflectance\" [0.5 0.4 0.3]\n\
+         Shape \"trianglemesh\" \"point3 P\" [-4 -1 -4  4 -1 -4  4 -1 4  -4 -1 4] \"integer indices\" [0 2 1 0 3 2]\n",
+    )
+    .unwrap();
+    let (out, xml) = export("scene-file-out", &[scene.to_str().unwrap(), "--no-specular"]);
+    assert!(xml.contains("<medium type=\"homogeneous\""), "{xml}");
+    assert!(xml.contains("<rgb name=\"reflectance\" value=\"0.5"), "the floor: {xml}");
+    assert!(out.join("object1.ply").is_file());
+    assert!(xml.contains("<integer name=\"width\" value=\"64\"/>"), "the film's size: {xml}");
+}

@@ -21,7 +21,14 @@ pub(super) fn mitsuba(args: &MitsubaArgs) -> Result<i32> {
         return Err(bad_input!("--light-radius {}: must be within (0, 90) degrees", args.light_radius));
     }
     let r = &args.render;
-    let settings = RenderSettings::from_args(r)?;
+    // A scene file (pbrt-v4, glTF) as `render` reads it; `--out` stays the folder.
+    let settings = match &r.scene {
+        Some(scene) => {
+            let argv: Vec<String> = std::env::args().collect();
+            crate::settings::scene_file_settings(scene, r, &|f| crate::pbrt::flag_given(&argv, f))?.1
+        }
+        None => RenderSettings::from_args(r)?,
+    };
     if !args.render.no_specular {
         crate::note!(
             "warning: render's microfacet reflection (--roughness) is not exported: Mitsuba's boundary is smooth; compare with --no-specular (scripts/reference then subtracts the boundary's reflection)"
@@ -66,7 +73,23 @@ pub(super) fn mitsuba(args: &MitsubaArgs) -> Result<i32> {
         };
         objects.push(Object { name: m.name.clone(), mesh, mm_per_unit: mm, surface });
     }
-    let m = &world.objects[0].material;
+    // Opaque objects (a scene file's `diffuse` shapes): Lambertian; a textured reflectance is
+    // written as its mean, with a warning.
+    let opaque_meshes: Vec<_> = world.opaque.iter().map(|o| o.world_mesh()).collect();
+    for (k, (o, mesh)) in world.opaque.iter().zip(&opaque_meshes).enumerate() {
+        if !matches!(o.reflectance, crate::world::Reflectance::Constant(_)) {
+            crate::note!("warning: opaque object {k}: its textured reflectance is exported as its mean");
+        }
+        let reflectance = o.reflectance.mean().as_dvec3().to_array();
+        objects.push(Object {
+            name: format!("opaque {k}"),
+            mesh,
+            mm_per_unit: mm,
+            surface: Surface::Diffuse { reflectance },
+        });
+    }
+    let material_name =
+        world.objects.first().map_or("none (opaque objects only)".to_string(), |o| o.material.name.clone());
     let options = Options {
         width: desc.width,
         height: desc.height,
@@ -88,7 +111,7 @@ pub(super) fn mitsuba(args: &MitsubaArgs) -> Result<i32> {
         "spp": args.spp,
         "subsurface_only": r.no_specular,
         "light_radius_deg": args.light_radius,
-        "material": m.name,
+        "material": material_name,
         "command": command.join(" "),
     });
     let info_path = dir.join("reference.json");
