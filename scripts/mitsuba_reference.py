@@ -19,6 +19,7 @@ def main():
     p.add_argument("dir")
     p.add_argument("--spp", type=int, default=1024, help="samples per pixel per seed")
     p.add_argument("--seeds", type=int, default=2, help="independent renders (at least 2)")
+    p.add_argument("--first-seed", type=int, default=0, help="the first seed (to add renders to earlier ones)")
     p.add_argument("--variant", default=None)
     p.add_argument("--max-depth", type=int, default=None)
     p.add_argument("--rr-depth", type=int, default=None)
@@ -45,7 +46,7 @@ def main():
     subtract = bool(info.get("subsurface_only"))
     start = time.time()
     images = []
-    for seed in range(a.seeds):
+    for seed in range(a.first_seed, a.first_seed + a.seeds):
         full = np.array(mi.render(mi.load_file(scene_path, seed=seed, **params)), dtype=np.float64)
         if subtract:
             refl = np.array(mi.render(mi.load_file(scene_path, seed=seed, transmittance=0.0, **params)), dtype=np.float64)

@@ -107,6 +107,16 @@ pub fn obj_diffuse_map(path: &Path) -> Result<Option<(PathBuf, Vec3)>> {
     for lib in words("mtllib") {
         let lib_path = dir.join(lib);
         let bytes = read_mesh_file(&lib_path).map_err(|e| bad_input!("mesh {shown}: mtllib {lib}: {e}"))?;
+        // tobj 4.0.5 panics on a colour with fewer than three numbers (parse_float3's unwrap):
+        // refused here first, naming the line.
+        for (n, line) in String::from_utf8_lossy(&bytes).lines().enumerate() {
+            let mut words = line.split_whitespace();
+            if let Some(key @ ("Ka" | "Kd" | "Ks" | "Ke")) = words.next() {
+                if words.count() < 3 {
+                    return Err(bad_input!("mesh {shown}: mtllib {lib}: line {}: {key} takes three numbers", n + 1));
+                }
+            }
+        }
         let (materials, _) = tobj::load_mtl_buf(&mut std::io::BufReader::new(bytes.as_slice()))
             .map_err(|e| bad_input!("mesh {shown}: mtllib {lib}: not a readable MTL file: {e}"))?;
         for m in materials {

@@ -683,6 +683,37 @@ fn fuzz_findings_stay_fixed() {
     }
 }
 
+/// An OBJ's material library, any text: its colour map is found, or the file refused as bad input
+/// naming the library, never a panic (tobj's MTL parser on what users write).
+fn mtl_text() -> impl Strategy<Value = String> {
+    let line = prop_oneof![
+        "newmtl [a-z]{0,3}".prop_map(|s| s),
+        "map_Kd [a-z./ ]{0,12}".prop_map(|s| s),
+        (triple()).prop_map(|t| format!("Kd {t}")),
+        "[A-Za-z_]{1,8} [ -~]{0,20}".prop_map(|s| s),
+        Just(String::new()),
+    ];
+    prop::collection::vec(line, 0..12).prop_map(|lines| lines.join("\n"))
+}
+
+fn check_mtl((obj, mtl): (String, String)) -> Result<(), TestCaseError> {
+    let dir = std::env::temp_dir().join(format!("translucent-fuzz-mtl-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).map_err(|e| TestCaseError::fail(e.to_string()))?;
+    let (obj_path, mtl_path) = (dir.join("m.obj"), dir.join("m.mtl"));
+    std::fs::write(&obj_path, format!("mtllib m.mtl\n{obj}\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")).unwrap();
+    std::fs::write(&mtl_path, &mtl).unwrap();
+    match translucent::mesh::obj_diffuse_map(&obj_path) {
+        Ok(_) => Ok(()),
+        Err(e) if e.exit_code() == 2 && e.to_string().contains("m.obj") => Ok(()),
+        Err(e) => Err(TestCaseError::fail(format!("{e}"))),
+    }
+}
+
+#[test]
+fn obj_material_library_properties() {
+    run_cases(&("(usemtl [a-z]{0,3}\n){0,2}", mtl_text()), 400, 31, check_mtl);
+}
+
 #[test]
 fn obj_reader_properties() {
     run_cases(&obj_text(), CI_CASES, 1, |b| check_obj(&b));
