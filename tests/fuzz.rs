@@ -712,6 +712,7 @@ fn check_mtl((obj, mtl): (String, String)) -> Result<(), TestCaseError> {
 #[test]
 fn obj_material_library_properties() {
     run_cases(&("(usemtl [a-z]{0,3}\n){0,2}", mtl_text()), 400, 31, check_mtl);
+    let _ = std::fs::remove_dir_all(std::env::temp_dir().join(format!("translucent-fuzz-mtl-{}", std::process::id())));
 }
 
 #[test]
