@@ -140,6 +140,19 @@ impl Light {
         Ok(Light::Spot { position, axis, intensity, cone_deg, delta_deg })
     }
 
+    /// The same light in units `factor` times smaller (a world re-expressed in other units): a
+    /// position scaled by `factor`, and a point or spot light's intensity by factor², so that
+    /// its irradiance E = I/d² at every point of the scaled world stays what it was.
+    pub fn in_units_scaled_by(&mut self, factor: f32) {
+        match self {
+            Light::Directional { .. } => {}
+            Light::Point { position, intensity } | Light::Spot { position, intensity, .. } => {
+                *position *= factor;
+                *intensity *= factor * factor;
+            }
+        }
+    }
+
     /// The light's position (point and spot lights).
     pub fn position(&self) -> Option<Vec3> {
         match *self {

@@ -142,6 +142,25 @@ impl SceneSettings {
     }
 }
 
+/// A world far from unit size (its first object's bounding sphere) re-expressed in power-of-two
+/// units, as scenes from flags are: every mesh, the camera and the lights' positions scaled, the
+/// millimetres per unit divided by the same factor (scene files, pbrt-v4's and glTF's).
+pub(crate) fn rescale_world(world: &mut crate::world::World, camera: &mut Camera, lights: &mut [Light]) {
+    let first = world.objects.first().map(|o| &o.mesh).or(world.opaque.first().map(|o| &o.mesh));
+    let Some(first) = first else { return };
+    let (_, radius) = crate::scene::bounding_sphere(&first.positions);
+    let Some(factor) = rescale_factor(radius) else { return };
+    for mesh in world.objects.iter_mut().map(|o| &mut o.mesh).chain(world.opaque.iter_mut().map(|o| &mut o.mesh)) {
+        mesh.positions.iter_mut().for_each(|p| *p *= factor);
+    }
+    world.mm_per_unit /= factor;
+    camera.eye *= factor;
+    camera.target *= factor;
+    for light in lights {
+        light.in_units_scaled_by(factor);
+    }
+}
+
 /// The power of two that brings a radius far from 1 (outside [1/64, 64]) near it, if it is.
 pub(crate) fn rescale_factor(radius: f32) -> Option<f32> {
     if (1.0 / 64.0..=64.0).contains(&radius) || radius.is_nan() || radius <= 0.0 {
@@ -161,9 +180,7 @@ pub(crate) fn rescaled(mut scene: Scene, radius: f32) -> Scene {
     scene.camera.eye *= factor;
     scene.camera.target *= factor;
     for light in &mut scene.lights {
-        if let Some(position) = light.position_mut() {
-            *position *= factor;
-        }
+        light.in_units_scaled_by(factor);
     }
     scene
 }

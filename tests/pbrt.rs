@@ -460,3 +460,42 @@ fn a_scene_of_diffuse_shapes_only_renders_them_lit_with_a_warning() {
     assert_eq!(out.status.code(), Some(2), "{}", common::stderr(&out));
     assert!(common::stderr(&out).contains("no shape with a subsurface or diffuse material"));
 }
+
+/// A scene far from unit size is re-expressed in power-of-two units with its lights: a spot
+/// light's position is scaled with the shapes (it was left where it was, inside the rescaled
+/// sphere, and the image came out black), so the same scene at 1/1000 of the size, with its
+/// subsurface scale 1000 times larger, renders the same image.
+#[test]
+fn a_spot_light_scales_with_a_scene_far_from_unit_size() {
+    let d = dir("spot-scale");
+    let scene = |size: f64| {
+        format!(
+            "LookAt 0 {} {}  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 40\n\
+             Film \"rgb\" \"integer xresolution\" 32 \"integer yresolution\" 32\nWorldBegin\n\
+             LightSource \"spot\" \"point3 from\" [0 {} 0] \"point3 to\" [0 0 0] \"float coneangle\" 40 \"rgb I\" [{} {} {}]\n\
+             Material \"subsurface\" \"string name\" \"Skin1\" \"float scale\" {}\n\
+             Shape \"sphere\" \"float radius\" {}\n",
+            2.0 * size,
+            4.0 * size,
+            4.0 * size,
+            16.0 * size * size,
+            16.0 * size * size,
+            16.0 * size * size,
+            10.0 / size,
+            size
+        )
+    };
+    let mut means = Vec::new();
+    for (name, size) in [("unit", 1.0), ("small", 0.001)] {
+        let path = d.join(format!("{name}.pbrt"));
+        std::fs::write(&path, scene(size)).unwrap();
+        let out = d.join(format!("{name}.exr"));
+        let o = render(&[path.to_str().unwrap(), "--out", out.to_str().unwrap(), "--no-specular", "--samples", "4096"]);
+        assert!(o.status.success(), "{}", common::stderr(&o));
+        let img = image::open(&out).unwrap().into_rgba32f();
+        let covered: Vec<_> = img.pixels().filter(|p| p.0[3] > 0.0).map(|p| p.0[0] as f64).collect();
+        means.push(covered.iter().sum::<f64>() / covered.len().max(1) as f64);
+    }
+    assert!(means[0] > 0.0, "{means:?}");
+    assert!((means[1] / means[0] - 1.0).abs() < 0.02, "the small scene against the unit one: {means:?}");
+}

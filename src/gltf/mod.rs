@@ -391,23 +391,10 @@ pub fn render_settings(
     for (o, path) in world.objects.iter().zip(&translucent_paths) {
         crate::world::check_geometry(&o.mesh, mm_per_unit).map_err(|e| bad_input!("{shown}: {path}: {e}"))?;
     }
-    // Far from unit size: re-expressed in power-of-two units, as scenes from flags are.
-    let first = world.objects.first().map(|o| &o.mesh).or(world.opaque.first().map(|o| &o.mesh));
-    let first = first.ok_or_else(|| bad_input!("{shown}: the scene has no mesh"))?;
-    let (_, first_radius) = crate::scene::bounding_sphere(&first.positions);
-    if let Some(factor) = crate::settings::rescale_factor(first_radius) {
-        for mesh in world.objects.iter_mut().map(|o| &mut o.mesh).chain(world.opaque.iter_mut().map(|o| &mut o.mesh)) {
-            mesh.positions.iter_mut().for_each(|p| *p *= factor);
-        }
-        world.mm_per_unit /= factor;
-        cam.eye *= factor;
-        cam.target *= factor;
-        for l in &mut lights {
-            if let Some(position) = l.position_mut() {
-                *position *= factor;
-            }
-        }
+    if world.objects.is_empty() && world.opaque.is_empty() {
+        return Err(bad_input!("{shown}: the scene has no mesh"));
     }
+    crate::settings::rescale_world(&mut world, &mut cam, &mut lights);
     settings.world = world;
     (settings.desc.camera, settings.desc.lights) = (cam, lights);
     settings.desc.validate()?;

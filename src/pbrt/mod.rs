@@ -579,24 +579,10 @@ pub fn render_settings(
             return Err(bad_input!("{}: the object is {size_mm:.3e} mm across at scale {mm_per_unit} mm per unit; it must be within [{:e}, {:e}] mm", sub.loc, limits.0, limits.1));
         }
     }
-    // Far from unit size: re-expressed in power-of-two units, as scenes from flags are.
-    let first = world.objects.first().map(|o| &o.mesh).or(world.opaque.first().map(|o| &o.mesh));
-    let first =
-        first.ok_or_else(|| bad_input!("{}: no shape with a subsurface or diffuse material", path.display()))?;
-    let (_, radius) = crate::scene::bounding_sphere(&first.positions);
-    if let Some(factor) = crate::settings::rescale_factor(radius) {
-        for mesh in world.objects.iter_mut().map(|o| &mut o.mesh).chain(world.opaque.iter_mut().map(|o| &mut o.mesh)) {
-            mesh.positions.iter_mut().for_each(|p| *p *= factor);
-        }
-        world.mm_per_unit /= factor;
-        cam.eye *= factor;
-        cam.target *= factor;
-        for l in &mut lights {
-            if let Light::Point { position, .. } = l {
-                *position *= factor;
-            }
-        }
+    if world.objects.is_empty() && world.opaque.is_empty() {
+        return Err(bad_input!("{}: no shape with a subsurface or diffuse material", path.display()));
     }
+    crate::settings::rescale_world(&mut world, &mut cam, &mut lights);
     settings.world = world;
     (settings.desc.camera, settings.desc.lights) = (cam, lights);
     if let Some(env) = environment {
