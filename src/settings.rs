@@ -237,10 +237,7 @@ impl RenderSettings {
         let texture = obj_texture(&spec)?;
         // A colour map: the material's albedo is the map's mean (its mean free path is kept).
         let material = match &texture {
-            Some((map, _)) => {
-                let mean = map.mean();
-                material.with_reflectance([mean.x as f64, mean.y as f64, mean.z as f64])?
-            }
+            Some((map, _)) => crate::world::textured_material(&material, map)?,
             None => material,
         };
         let mut s = RenderSettings::new(scene, material);

@@ -129,6 +129,14 @@ impl Reflectance {
     }
 }
 
+/// `material` for an object coloured by `texture`: its mean free path, g and η, with the
+/// texture's mean reflectance as its albedo (the texture then weighs it per point); how a preset
+/// (`--material`, the viewer's material) is applied to a textured object, whatever its file.
+pub fn textured_material(material: &Material, texture: &Reflectance) -> Result<Material> {
+    let mean = texture.mean();
+    material.with_reflectance([mean.x as f64, mean.y as f64, mean.z as f64])
+}
+
 /// An image of linear reflectances, rows from the top.
 #[derive(Clone, Debug)]
 pub struct Texture {

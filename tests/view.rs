@@ -670,3 +670,69 @@ fn assert_screenshot_equals_render(shot: &Path, render: &[&str], rendered: &Path
     let diff = output::compare(&load(shot), &load(rendered)).unwrap();
     assert!(diff.rmse < 0.5 && diff.differing_fraction < 0.001, "{diff:?}");
 }
+
+/// A textured translucent mesh (an OBJ's `map_Kd`) keeps its colour when the viewer's script
+/// changes its material and model: the screenshot equals `render` with `--material` and
+/// `--model` typed (the preset's mean free path, the texture's mean as its albedo, the texture
+/// weighing it per point), and the two halves keep their colours.
+#[test]
+fn a_textured_mesh_edited_in_the_viewer_equals_render() {
+    if !have_xvfb() {
+        return;
+    }
+    let dir = output_dir().join("view-textured");
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut obj = String::from("mtllib box.mtl\nusemtl painted\n");
+    for k in 0..8 {
+        let (x, y, z) = (
+            if k & 1 == 0 { -1.0 } else { 1.0 },
+            if k & 2 == 0 { -0.3 } else { 0.3 },
+            if k & 4 == 0 { -1.0 } else { 1.0 },
+        );
+        obj += &format!("v {x} {y} {z}\nvt {} 0.5\n", if x < 0.0 { 0.02 } else { 0.98 });
+    }
+    for f in [[0, 4, 6, 2], [1, 3, 7, 5], [0, 1, 5, 4], [2, 6, 7, 3], [0, 2, 3, 1], [4, 5, 7, 6]] {
+        obj += &format!(
+            "f {}/{} {}/{} {}/{} {}/{}\n",
+            f[0] + 1,
+            f[0] + 1,
+            f[1] + 1,
+            f[1] + 1,
+            f[2] + 1,
+            f[2] + 1,
+            f[3] + 1,
+            f[3] + 1
+        );
+    }
+    std::fs::write(dir.join("box.obj"), obj).unwrap();
+    std::fs::write(dir.join("box.mtl"), "newmtl painted\nmap_Kd colours.png\n").unwrap();
+    let map = image::RgbImage::from_fn(8, 1, |x, _| image::Rgb(if x < 4 { [230, 160, 120] } else { [90, 60, 200] }));
+    map.save(dir.join("colours.png")).unwrap();
+    let mesh = dir.join("box.obj");
+    let common =
+        ["--mesh", mesh.to_str().unwrap(), "--width", "96", "--height", "72", "--samples", "8192", "--exposure", "0"];
+    let (shot, rendered) = (png("textured"), png("textured-render"));
+    let line = format!("screenshot {}", shot.display());
+    let mut args = common.to_vec();
+    args.push("--no-panel");
+    let script = ["material skin1", "set model dipole", "frames 1", &line, "quit"];
+    assert_ok("textured", &view("textured", &args, &script));
+    let mut render_args = vec!["render", "--validation"];
+    render_args.extend(common);
+    render_args.extend(["--material", "skin1", "--model", "dipole", "--out", rendered.to_str().unwrap()]);
+    let out = translucent(&render_args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let (a, b) = (load(&shot), load(&rendered));
+    assert!(a == b, "the viewer's screenshot differs from render's image");
+    // The left half warm, the right half blue (the mean over each half's covered pixels).
+    let w = a.width();
+    let half = |left: bool| {
+        let mut sum = [0.0f64; 3];
+        for (_, _, p) in a.enumerate_pixels().filter(|(x, _, p)| p[3] > 0 && (*x < w / 2) == left) {
+            (0..3).for_each(|c| sum[c] += p[c] as f64);
+        }
+        sum
+    };
+    let (l, r) = (half(true), half(false));
+    assert!(l[0] > l[2] && r[2] > r[0], "the halves' colours: {l:?} {r:?}");
+}

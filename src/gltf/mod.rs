@@ -302,13 +302,19 @@ pub fn render_settings(
                     m
                 }
             };
+            // The texture, carried for the shading to use per point, whatever gives the
+            // material (not where KHR_materials_volume_scatter's colour gives the reflectance):
+            // a preset keeps its mean free path and takes the texture's mean as its albedo.
+            let texture = desc.texture.as_ref().filter(|_| desc.multiscatter.is_none());
+            let texture = texture.map(|t| crate::world::Reflectance::Image(t.clone()));
+            let material = match &texture {
+                Some(t) if given("--material") || preset.is_some() => crate::world::textured_material(&material, t)?,
+                _ => material,
+            };
             let mut object = crate::world::Object::new(mesh, material);
             object.samples = args.samples;
-            // The texture, carried for the shading to use per point (the material is its mean's);
-            // not where a preset or KHR_materials_volume_scatter's colour gives the reflectance.
-            if let (false, None, None, Some(t)) = (given("--material"), preset, desc.multiscatter, &desc.texture) {
-                object.texture = Some(crate::world::Reflectance::Image(t.clone()));
-                object.uvs = uvs;
+            if texture.is_some() {
+                (object.texture, object.uvs) = (texture, uvs);
             }
             objects.push(object);
         } else {

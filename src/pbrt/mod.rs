@@ -523,9 +523,11 @@ pub fn render_settings(
                     o.shape
                 ));
             }
-            // The material is the texture's mean colour; the texture weighs it per point.
-            let typed = ["--material", "--sigma-a", "--sigma-s", "--g"].iter().any(|f| given(f));
-            if !typed {
+            // The material is the texture's mean colour; the texture weighs it per point. A preset
+            // typed keeps its mean free path and takes the texture's mean as its albedo.
+            if given("--material") {
+                material = crate::world::textured_material(&material, texture)?;
+            } else if !["--sigma-a", "--sigma-s", "--g"].iter().any(|f| given(f)) {
                 let mean = texture.mean();
                 let top = max_reflectance(sub.eta) * 0.999;
                 let mean = [0, 1, 2].map(|c| (mean[c] as f64).min(top));

@@ -175,8 +175,13 @@ impl ViewState {
                 d.lights.remove(light_index(k)?);
             }
             Action::Material(name) => {
-                let material = Material::find(&name)?;
-                self.first_object()?.material = material;
+                let preset = Material::find(&name)?;
+                let object = self.first_object()?;
+                // A textured object keeps its colour, as `--material` makes it.
+                object.material = match &object.texture {
+                    Some(texture) => crate::world::textured_material(&preset, texture)?,
+                    None => preset,
+                };
             }
             Action::TogglePause => self.playing = !self.playing,
             Action::Set(setting) => match setting {
