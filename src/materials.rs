@@ -413,9 +413,7 @@ mod tests {
             assert_eq!(w.of(own), [1.0; 3], "{model:?}");
             let steps: Vec<[f64; 3]> = (0..=20).map(|k| w.of([k as f64 * 0.04; 3])).collect();
             for pair in steps.windows(2) {
-                for c in 0..3 {
-                    assert!(pair[1][c] > pair[0][c], "{model:?} channel {c}: {steps:?}");
-                }
+                assert!((0..3).all(|c| pair[1][c] > pair[0][c]), "{model:?}: {steps:?}");
             }
             assert_eq!(w.of([0.0; 3]), [0.0; 3]);
         }
