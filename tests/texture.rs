@@ -207,28 +207,7 @@ fn obj_map_kd_colours_a_translucent_mesh() {
     let dir = common::output_dir().join("texture-obj");
     std::fs::create_dir_all(&dir).unwrap();
     let (h, t) = (50.0f32, 10.0f32);
-    let mut obj = String::from("mtllib box.mtl\nusemtl painted\n");
-    let mut obj_no_vt = String::from("mtllib box.mtl\nusemtl painted\n");
-    for k in 0..8 {
-        let (x, y, z) =
-            (if k & 1 == 0 { -h } else { h }, if k & 2 == 0 { -t } else { t }, if k & 4 == 0 { -h } else { h });
-        obj += &format!("v {x} {y} {z}\nvt {} 0.5\n", if x < 0.0 { 0.02 } else { 0.98 });
-        obj_no_vt += &format!("v {x} {y} {z}\n");
-    }
-    for f in [[0, 4, 6, 2], [1, 3, 7, 5], [0, 1, 5, 4], [2, 6, 7, 3], [0, 2, 3, 1], [4, 5, 7, 6]] {
-        obj += &format!(
-            "f {}/{} {}/{} {}/{} {}/{}\n",
-            f[0] + 1,
-            f[0] + 1,
-            f[1] + 1,
-            f[1] + 1,
-            f[2] + 1,
-            f[2] + 1,
-            f[3] + 1,
-            f[3] + 1
-        );
-        obj_no_vt += &format!("f {} {} {} {}\n", f[0] + 1, f[1] + 1, f[2] + 1, f[3] + 1);
-    }
+    let (obj, obj_no_vt) = (common::box_obj(h, t, true), common::box_obj(h, t, false));
     std::fs::write(dir.join("box.obj"), &obj).unwrap();
     std::fs::write(dir.join("box-no-vt.obj"), &obj_no_vt).unwrap();
     std::fs::write(dir.join("box.mtl"), "newmtl painted\nKd 1 1 1\nmap_Kd colours.png\n").unwrap();

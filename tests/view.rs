@@ -682,28 +682,7 @@ fn a_textured_mesh_edited_in_the_viewer_equals_render() {
     }
     let dir = output_dir().join("view-textured");
     std::fs::create_dir_all(&dir).unwrap();
-    let mut obj = String::from("mtllib box.mtl\nusemtl painted\n");
-    for k in 0..8 {
-        let (x, y, z) = (
-            if k & 1 == 0 { -1.0 } else { 1.0 },
-            if k & 2 == 0 { -0.3 } else { 0.3 },
-            if k & 4 == 0 { -1.0 } else { 1.0 },
-        );
-        obj += &format!("v {x} {y} {z}\nvt {} 0.5\n", if x < 0.0 { 0.02 } else { 0.98 });
-    }
-    for f in [[0, 4, 6, 2], [1, 3, 7, 5], [0, 1, 5, 4], [2, 6, 7, 3], [0, 2, 3, 1], [4, 5, 7, 6]] {
-        obj += &format!(
-            "f {}/{} {}/{} {}/{} {}/{}\n",
-            f[0] + 1,
-            f[0] + 1,
-            f[1] + 1,
-            f[1] + 1,
-            f[2] + 1,
-            f[2] + 1,
-            f[3] + 1,
-            f[3] + 1
-        );
-    }
+    let obj = common::box_obj(1.0, 0.3, true);
     std::fs::write(dir.join("box.obj"), obj).unwrap();
     std::fs::write(dir.join("box.mtl"), "newmtl painted\nmap_Kd colours.png\n").unwrap();
     let map = image::RgbImage::from_fn(8, 1, |x, _| image::Rgb(if x < 4 { [230, 160, 120] } else { [90, 60, 200] }));

@@ -452,13 +452,14 @@ pub fn write_scene(
         write_ply(&path, o.mesh, o.mm_per_unit)?;
         written.meshes.push(path);
         let _ = writeln!(w, "    <!-- {} -->", xml_comment(&o.name));
-        match &o.surface {
-            Surface::Translucent(_) | Surface::TexturedTranslucent { .. } => {
-                let (m, grid) = match &o.surface {
-                    Surface::TexturedTranslucent { medium, albedo } => (medium, Some(albedo)),
-                    Surface::Translucent(m) => (m, None),
-                    Surface::Diffuse { .. } => unreachable!("matched above"),
-                };
+        // A translucent object's medium, and its albedo grid when it is textured.
+        let translucent = match &o.surface {
+            Surface::Translucent(m) => Ok((m, None)),
+            Surface::TexturedTranslucent { medium, albedo } => Ok((medium, Some(albedo))),
+            Surface::Diffuse { reflectance } => Err(reflectance),
+        };
+        match translucent {
+            Ok((m, grid)) => {
                 let mut h = homogeneous(m);
                 if let Some(warning) = &h.warning {
                     written.warnings.push(format!("{}: {warning}", o.name));
@@ -514,7 +515,7 @@ pub fn write_scene(
                 let _ = writeln!(w, "        <ref name=\"interior\" id=\"medium{i}\"/>");
                 let _ = writeln!(w, "    </shape>");
             }
-            Surface::Diffuse { reflectance } => {
+            Err(reflectance) => {
                 let _ = writeln!(w, "    <shape type=\"ply\" id=\"object{i}\">");
                 let _ = writeln!(w, "        <string name=\"filename\" value=\"{ply}\"/>");
                 let _ = writeln!(

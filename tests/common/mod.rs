@@ -172,3 +172,24 @@ pub fn dirpole_plane_integral(
     }
     sum
 }
+
+/// An OBJ box `2·half` wide (x, z) and `2·thickness` tall (y), 8 shared corners, faces
+/// counter-clockwise from outside, using material `painted` of `box.mtl`; with `vt` (u 0.02 at
+/// x < 0, 0.98 at x > 0, v 0.5) on every vertex when `uv`.
+#[allow(dead_code)]
+pub fn box_obj(half: f32, thickness: f32, uv: bool) -> String {
+    let mut obj = String::from("mtllib box.mtl\nusemtl painted\n");
+    for k in 0..8 {
+        let side = |bit: i32, v: f32| if k & bit == 0 { -v } else { v };
+        let (x, y, z) = (side(1, half), side(2, thickness), side(4, half));
+        obj += &format!("v {x} {y} {z}\n");
+        if uv {
+            obj += &format!("vt {} 0.5\n", if x < 0.0 { 0.02 } else { 0.98 });
+        }
+    }
+    for f in [[0, 4, 6, 2], [1, 3, 7, 5], [0, 1, 5, 4], [2, 6, 7, 3], [0, 2, 3, 1], [4, 5, 7, 6]] {
+        let corner = |i: usize| if uv { format!("{0}/{0}", f[i] + 1) } else { (f[i] + 1).to_string() };
+        obj += &format!("f {} {} {} {}\n", corner(0), corner(1), corner(2), corner(3));
+    }
+    obj
+}
