@@ -1,10 +1,10 @@
 #version 460
 // Subsurface scattering per pixel, in a full-screen pass over the G-buffer of the surface pass.
 // The pixel's sources come from its tile's list (tile_cut.comp): nodes used whole for the whole
-// tile (two sigma points), points evaluated singly, and frontier
-// nodes that this pixel walks on its own (a node far and small enough from xo, area / distance²
-// < epsilon and xo outside its box, is used whole, else its children are visited). A tile whose
-// list did not fit sums from the root instead. Every source carries all the lights at once
+// tile (two sigma points) and points evaluated singly, the same list for every pixel of the tile.
+// A tile whose list did not fit walks from the root per pixel instead (a node far and small
+// enough from xo, area / distance² < epsilon and xo outside its box, is used whole, else its
+// children are visited). Every source carries all the lights at once
 // (PointFlux, NodeFlux: per channel the power and the power-weighted refracted direction), so the
 // cost does not grow with the number of lights; brute force instead sums over every (point,
 // light) pair exactly, the reference the merged records are measured against.
@@ -603,8 +603,9 @@ void main() {
         // The tile's list (tile_cut.comp): every lane of the tile runs the same evaluations in
         // the same order, one loop iteration each, so the lanes of a SIMD group or warp stay
         // together and load the same records.
-        uint tiles_across = (uint(imageSize(surface_position).x) + TILE_SIZE - 1u) / TILE_SIZE;
-        uvec4 tile = texel(tile_headers, (uint(pixel.y) / TILE_SIZE) * tiles_across + uint(pixel.x) / TILE_SIZE);
+        uint list_tile = pc.point_range.w;
+        uint tiles_across = (uint(imageSize(surface_position).x) + list_tile - 1u) / list_tile;
+        uvec4 tile = texel(tile_headers, (uint(pixel.y) / list_tile) * tiles_across + uint(pixel.x) / list_tile);
         uint entry = tile.x;
         uint point_count = tile.y & 0xffffu, near_count = tile.y >> 16;
         // The points within the near field's reach of the tile, with its control variate.
@@ -656,23 +657,20 @@ void main() {
                  + merged_source(center - offset, ni, power, incident, vec3(0.0), xo, no, true);
         }
         visits += tile.z;
-        entry += tile.z;
 
-        // Frontier nodes: each pixel walks them with its own stack, as the walk without tiles
-        // did from the root. Points are pushed like nodes, so that each step evaluates at most
+        // A tile whose list did not fit this frame: each pixel walks the tree from the root with
+        // its own stack. Points are pushed like nodes, so that each step evaluates at most
         // one source at one place in the code: the lanes of a SIMD group (llvmpipe) or warp (GPU)
         // that evaluate in a step do it together, whether their source is a node or a point.
         // Stack entries are a point or node and, in bits 24-28, which of its evaluations is
         // next: 0 for a fresh entry (test it first), e + 1 for evaluation e. A source's
         // evaluations (one for a point, two sigma points for a node) are steps of this one
         // loop, each pushing the next.
-        bool from_root = tile.w == WALK_FROM_ROOT;
-        uint frontier_count = from_root ? 1u : tile.w;
-        uint steps = evaluations;
-        for (uint f = 0u; f < frontier_count; ++f) {
+        if (tile.w == WALK_FROM_ROOT) {
+            uint steps = evaluations;
             uint stack[STACK_SIZE];
             uint top = 0u;
-            stack[top++] = from_root ? 0u : tile_entry(entry + f);
+            stack[top++] = 0u;
             while (top > 0u) {
                 uint item_entry = stack[--top];
                 ++steps;

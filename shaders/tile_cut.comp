@@ -1,13 +1,15 @@
 #version 460
-// The cut per screen tile (TILE_SIZE² pixels): the sources that are far and small enough for
+// The cut per screen tile (list_tile² pixels, 4 or 8: passes/tile_cut.rs): the sources that are far and small enough for
 // every pixel of the tile, found once, so that the shade pass's lanes for the tile (a SIMD group
 // on llvmpipe, a warp on a GPU) evaluate the same list in step instead of each walking the tree.
 // One invocation per tile: the tile's surface positions bound a box T; walking from the root, a
 // node is used whole for the whole tile when it is whole for every point of T (its box misses T
 // and area < epsilon · distance² from its centre to T), so each pixel's sum is its own cut or a
-// finer one, never coarser. A node that some pixel must open and that is small beside T (silhouette
-// tiles span depth) becomes a frontier entry: each pixel walks it on its own, as without tiles.
-// Points (leaves) reached are evaluated singly. The walk runs twice: once to count, then, after
+// finer one, never coarser; a node that some pixel must open is opened for all of them, down to
+// points (leaves), evaluated singly. Every pixel thus evaluates the same list in step: handing
+// the nodes near the tile to each pixel's own walk instead (a private stack per lane, divergent)
+// made that walk 80% of the default frame's shade pass, where the finer common list costs 22% more
+// evaluations (measured: BENCHMARKS.md, "A clean frame"). The walk runs twice: once to count, then, after
 // one atomic allocation in the list buffer, to write; a tile whose list does not fit is marked
 // for a walk from the root per pixel (the host then grows the buffer for the next try).
 #include "points.glsl"
@@ -29,7 +31,7 @@ layout(push_constant) uniform TileCutConstants {
     uvec2 pixels;     // image width and height
     uint capacity;    // entries the list buffer holds
     uint object;      // the object whose pixels and tree these lists are of
-    uint pad0;
+    uint list_tile;   // pixels per side of a tile
     uint pad1;
 } pc;
 
@@ -60,10 +62,9 @@ uint next_after(uint last) {
 }
 
 // Counts (write = false) or writes (write = true, at `first`) the tile's list; returns the counts
-// of points, nodes and frontier entries, and of the points within the near field's reach of the
-// tile, which are written first (only they need the control variate, shade.frag).
+// of points and nodes (x, y), and of the points within the near field's reach of the tile (w),
+// which are written first (only they need the control variate, shade.frag).
 uvec4 walk(vec3 tile_lo, vec3 tile_hi, bool write, uint first, uvec4 counts) {
-    float tile_extent2 = dot(tile_hi - tile_lo, tile_hi - tile_lo);
     uvec4 n = uvec4(0u);
     // The near field's reach, in scene units squared (0: no near field this frame).
     bool near = frame_params.near_field != 0u;
@@ -113,11 +114,6 @@ uvec4 walk(vec3 tile_lo, vec3 tile_hi, bool write, uint first, uvec4 counts) {
             if (write) entries[first + counts.x + n.y] = index;
             ++n.y;
             item = after;
-        } else if (dot(hi - lo, hi - lo) * 4.0 < tile_extent2) {
-            // Small beside the tile: pixels differ on how to cut it, so each walks it.
-            if (write) entries[first + counts.x + counts.y + n.z] = index;
-            ++n.z;
-            item = after;
         } else {
             item = center_left.w; // open it: its left child next
         }
@@ -129,11 +125,12 @@ void main() {
     uvec2 tile_xy = gl_GlobalInvocationID.xy;
     if (tile_xy.x >= pc.tiles.x || tile_xy.y >= pc.tiles.y) return;
     uint tile = tile_xy.y * pc.tiles.x + tile_xy.x;
-    ivec2 origin = ivec2(tile_xy) * int(TILE_SIZE);
+    int size = int(pc.list_tile);
+    ivec2 origin = ivec2(tile_xy) * size;
     vec3 lo = vec3(3.4e38), hi = vec3(-3.4e38);
     bool covered = false;
-    for (int y = 0; y < int(TILE_SIZE); ++y) {
-        for (int x = 0; x < int(TILE_SIZE); ++x) {
+    for (int y = 0; y < size; ++y) {
+        for (int x = 0; x < size; ++x) {
             ivec2 p = origin + ivec2(x, y);
             if (p.x >= int(pc.pixels.x) || p.y >= int(pc.pixels.y)) continue;
             vec4 s = imageLoad(surface_position, p);
@@ -148,7 +145,7 @@ void main() {
         return;
     }
     uvec4 counts = walk(lo, hi, false, 0u, uvec4(0u));
-    uint total = counts.x + counts.y + counts.z;
+    uint total = counts.x + counts.y;
     // The header packs the point count with the near points' (16 bits each): the lists'
     // evaluation budget keeps both far below 2^16.
     if (counts.x >= 65536u) {
@@ -161,5 +158,5 @@ void main() {
         return;
     }
     walk(lo, hi, true, first, counts);
-    headers[tile] = uvec4(first, counts.x | (counts.w << 16), counts.y, counts.z);
+    headers[tile] = uvec4(first, counts.x | (counts.w << 16), counts.y, 0u);
 }

@@ -22,7 +22,7 @@ use crate::passes::sampling::SamplingPass;
 use crate::passes::shade::{self, ShadeInputs, ShadePass, SurfaceDraw};
 use crate::passes::shadow::ShadowPass;
 use crate::passes::sort::SortPass;
-use crate::passes::tile_cut::{TileCutPass, TileLists};
+use crate::passes::tile_cut::{list_tile, TileCutPass, TileLists};
 use crate::passes::tonemap::{self, TonemapPass};
 use crate::passes::tree::TreePass;
 use crate::shadows::Shadows;
@@ -64,6 +64,7 @@ macro_rules! shade_inputs {
             point_spread: &o.hierarchy.sorted_point_spread,
             tile_headers: &lists.headers,
             tile_entries: &lists.entries,
+            list_tile: lists.list_tile,
             sd_table: &o.sd_table,
         }
     }};
@@ -128,6 +129,8 @@ pub struct Renderer {
     tile_lists: Vec<TileLists>,
     /// The most entries the lists may hold, when set lower than the device allows (tests).
     tile_list_limit: Option<u64>,
+    /// The list tiles' size when set (tests), else chosen per object and frame.
+    forced_list_tile: Option<u32>,
     /// Tile size and units per shading submission, learnt from the frames before.
     batching: ShadeBatching,
     /// Frames begun (a frame in progress may go on only while it is the latest).
@@ -182,6 +185,7 @@ impl Renderer {
             passes: Passes::new(&ctx)?,
             tile_lists: Vec::new(),
             tile_list_limit: None,
+            forced_list_tile: None,
             batching: ShadeBatching::default(),
             generation: 0,
             frames_done: 0,
@@ -199,6 +203,19 @@ impl Renderer {
         self.batching.set_target(seconds);
     }
 
+    /// List tiles of `size` pixels a side (one of `LIST_TILE_SIZES`) from the next frame on, or
+    /// (`None`) as `passes::tile_cut::list_tile` chooses per object and frame.
+    pub fn force_list_tile(&mut self, size: Option<u32>) -> Result<()> {
+        if let Some(s) = size.filter(|s| !crate::gpu::LIST_TILE_SIZES.contains(s)) {
+            return Err(crate::bad_input!(
+                "list tiles: {s} pixels a side is not one of {:?}",
+                crate::gpu::LIST_TILE_SIZES
+            ));
+        }
+        self.forced_list_tile = size;
+        Ok(())
+    }
+
     /// Tile lists of `capacity` entries from the next frame on, growing when a frame needs more
     /// up to `limit` entries (beyond it, a tile whose list does not fit is shaded by walking the
     /// tree from the root per pixel). For tests of those paths; the defaults suit rendering.
@@ -206,7 +223,7 @@ impl Renderer {
         self.ctx.wait_idle()?;
         let Extent2D { width, height } = self.targets.extent;
         for lists in &mut self.tile_lists {
-            *lists = TileLists::new(&self.ctx, width, height, Some(capacity), limit)?;
+            *lists = TileLists::new(&self.ctx, (width, height), lists.list_tile, Some(capacity), limit)?;
         }
         self.tile_list_limit = limit;
         Ok(())
@@ -515,9 +532,19 @@ impl Renderer {
         }
         // Tile lists for each object (made again with the targets, or for a new object).
         self.tile_lists.truncate(self.world.objects.len());
+        // Each object's list tiles from its pixels' width at its centre against its points' spacing.
+        let camera = &desc.camera;
+        let pixel_angle = 2.0 * (camera.fov_y_deg.to_radians() * 0.5).tan() / desc.height.max(1) as f32;
+        let tile_of = |o: &GpuObject| {
+            let footprint = pixel_angle * (0.5 * (o.bounds.0 + o.bounds.1) - camera.eye).length();
+            self.forced_list_tile.unwrap_or_else(|| list_tile(footprint, o.point_spacing, self.ctx.subgroup_size))
+        };
+        for (o, lists) in self.world.objects.iter().zip(&mut self.tile_lists) {
+            lists.set_list_tile(tile_of(o));
+        }
         while self.tile_lists.len() < self.world.objects.len() {
-            let limit = self.tile_list_limit;
-            self.tile_lists.push(TileLists::new(&self.ctx, desc.width, desc.height, None, limit)?);
+            let (limit, size) = (self.tile_list_limit, tile_of(&self.world.objects[self.tile_lists.len()]));
+            self.tile_lists.push(TileLists::new(&self.ctx, (desc.width, desc.height), size, None, limit)?);
         }
         let desc = desc.clone();
         let integration = desc.integration;

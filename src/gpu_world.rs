@@ -40,6 +40,8 @@ pub struct GpuObject {
     pub sd_table: Buffer,
     /// Its texture's scatter weight (1 everywhere without one).
     pub texture: SurfaceTexture,
+    /// The mean distance between its sample points, √(area / points), in scene units.
+    pub point_spacing: f32,
     /// What the buffers above were made from.
     made_from: MadeFrom,
 }
@@ -345,7 +347,7 @@ impl GpuWorld {
                 g.made_from.material = object.material.clone();
                 (g.made_from.diffusion, g.made_from.mm_per_unit) = (diffusion, world.mm_per_unit);
                 g.made_from.table = table;
-                write_params(&mut g.params, &mut g.sd_table, &g.made_from, point_count)?;
+                g.point_spacing = write_params(&mut g.params, &mut g.sd_table, &g.made_from, point_count)?;
             }
         }
         self.sync_opaque(ctx, world, desc, (relayout, shadow_resolution), bounds.into_iter().reduce(union))?;
@@ -437,7 +439,7 @@ impl GpuObject {
             BufferUsageFlags::UNIFORM_TEXEL_BUFFER,
             MemoryLocation::CpuToGpu,
         )?;
-        write_params(&mut params, &mut sd_table, &made_from, options.point_count)?;
+        let point_spacing = write_params(&mut params, &mut sd_table, &made_from, options.point_count)?;
         Ok(GpuObject {
             hierarchy,
             vertices,
@@ -447,6 +449,7 @@ impl GpuObject {
             params,
             sd_table,
             texture,
+            point_spacing,
             made_from,
         })
     }
@@ -461,8 +464,9 @@ fn upload_mesh(ctx: &Context, mesh: &Mesh) -> Result<(Buffer, Buffer, u32)> {
     Ok((vertices, indices, index_count))
 }
 
-/// Writes an object's parameters and its Sd table from what it is made from.
-fn write_params(params: &mut Buffer, table: &mut Buffer, from: &MadeFrom, point_count: u32) -> Result<()> {
+/// Writes an object's parameters and its Sd table from what it is made from; returns the
+/// points' mean spacing in scene units.
+fn write_params(params: &mut Buffer, table: &mut Buffer, from: &MadeFrom, point_count: u32) -> Result<f32> {
     let constants = |c: usize| from.material.channel(c).constants(from.diffusion);
     let channels = [0, 1, 2].map(|c| GpuChannel::from(&constants(c)));
     let area_mm2 = from.mesh.surface_area() * from.mm_per_unit * from.mm_per_unit;
@@ -508,5 +512,6 @@ fn write_params(params: &mut Buffer, table: &mut Buffer, from: &MadeFrom, point_
     table.write(0, &sd_table.texels())?;
     let factors_at = crate::gpu::sd_table::TABLE_SIZE * 16;
     table.write(factors_at as u64, &factors.texels())?;
-    table.write((factors_at + AngularFactors::TEXELS * 16) as u64, &across.texels())
+    table.write((factors_at + AngularFactors::TEXELS * 16) as u64, &across.texels())?;
+    Ok(spacing_mm / from.mm_per_unit)
 }

@@ -192,7 +192,7 @@ fn push_constants_match_glsl() {
         offset_of!(TileCutConstants, pixels),
         offset_of!(TileCutConstants, capacity),
         offset_of!(TileCutConstants, object),
-        offset_of!(TileCutConstants, pad0),
+        offset_of!(TileCutConstants, list_tile),
         offset_of!(TileCutConstants, pad1),
     ];
     assert_eq!(offsets("tile_cut.comp", "TileCutConstants"), cut.map(|o| o as u32));

@@ -95,3 +95,35 @@ fn tile_lists_grow_or_fall_back_to_walks_from_the_root() {
         assert!(e < 0.01, "{e}");
     }
 }
+
+/// Both sizes of list tiles: each pixel's list is its own cut or a finer one, so either size
+/// comes as close to brute force as each pixel walking the tree on its own, and the smaller
+/// tiles' lists, nearer each pixel's own cut, differ from that walk less.
+#[test]
+fn both_list_tile_sizes_are_as_close_to_brute_force_as_walks_from_the_root() {
+    let (mut renderer, scene, counts) = torus_renderer(false);
+    let mut images = Vec::new();
+    for size in translucent::gpu::LIST_TILE_SIZES {
+        renderer.force_list_tile(Some(size)).unwrap();
+        renderer.render_frame(&scene.0, &scene.1).unwrap();
+        images.push(renderer.image().unwrap().pixels);
+    }
+    assert!(renderer.force_list_tile(Some(5)).is_err(), "5 is no list tile size");
+    renderer.force_list_tile(None).unwrap();
+    renderer.set_tile_lists(4, Some(4)).unwrap();
+    renderer.render_frame(&scene.0, &scene.1).unwrap();
+    let from_root = renderer.image().unwrap().pixels;
+    drop(renderer);
+    common::assert_clean(&counts);
+
+    let brute = render(true, &[128]).remove(0);
+    let e_root = relative_rmse(&from_root, &brute);
+    let [e_small, e_large] = [0, 1].map(|k| relative_rmse(&images[k], &brute));
+    let [d_small, d_large] = [0, 1].map(|k| relative_rmse(&images[k], &from_root));
+    println!("against brute force: 4x4 {e_small:.5}, 8x8 {e_large:.5}, walks {e_root:.5}; against the walks: {d_small:.5}, {d_large:.5}");
+    assert!(images[0] != images[1], "the sizes cut differently");
+    for e in [e_small, e_large] {
+        assert!(e < 0.01 && e <= e_root * 1.05, "{e} against the walks' {e_root}");
+    }
+    assert!(d_small <= d_large, "4x4 lists nearer each pixel's own cut: {d_small} against {d_large}");
+}

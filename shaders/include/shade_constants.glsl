@@ -6,6 +6,7 @@ layout(push_constant, std430) uniform ShadeConstants {
     mat4 view_projection;
     vec4 eye;              // xyz: camera position
     uvec4 point_range;     // brute force: first point and count of this draw (draws add up);
-                           // z: the object drawn (surface pass) or shaded (shade pass)
+                           // z: the object drawn (surface pass) or shaded (shade pass);
+                           // w: pixels per side of its tile lists' tiles (shade pass)
 } pc;
 #endif

@@ -31,9 +31,10 @@ pub const LEAF_BIT: u32 = 0x8000_0000;
 /// Keys per tile of the radix sort (radix.glsl).
 pub const RADIX_TILE: u32 = 256;
 
-/// Pixels per side of the tile-cut pass's tiles: 8x8 = 64 pixels, a multiple of llvmpipe's 4x4
-/// fragment blocks and of a GPU warp or wave (tile_lists.glsl).
-pub const TILE_SIZE: u32 = 8;
+/// Pixels per side of the tile-cut pass's tiles, chosen per object and frame
+/// (`passes::tile_cut::list_tile`): 8x8 = 64 pixels, a multiple of a GPU warp or wave, or 4x4,
+/// llvmpipe's fragment block, where an 8x8 tile would span more than 1.5 point spacings.
+pub const LIST_TILE_SIZES: [u32; 2] = [4, 8];
 /// A tile header's frontier count meaning "no list: every pixel walks from the root" (the list
 /// did not fit in the buffer this frame).
 pub const WALK_FROM_ROOT: u32 = u32::MAX;
@@ -61,7 +62,6 @@ pub const GLSL_CONSTANTS: &[(&str, u32)] = &[
     ("SLAB_FIRST_NODE_LOG2_PLUS_8", SLAB_FIRST_NODE_LOG2_PLUS_8),
     ("LEAF_BIT", LEAF_BIT),
     ("RADIX_TILE", RADIX_TILE),
-    ("TILE_SIZE", TILE_SIZE),
     ("WALK_FROM_ROOT", WALK_FROM_ROOT),
     ("MAX_CUT_STEPS", MAX_CUT_STEPS),
     ("MAX_LIST_EVALUATIONS", MAX_LIST_EVALUATIONS),

@@ -126,6 +126,7 @@ pub struct TileCutConstants {
     pub capacity: u32,
     /// The object whose pixels (G-buffer position w = object + 1) and tree the lists are of.
     pub object: u32,
-    pub pad0: u32,
+    /// Pixels per side of a tile.
+    pub list_tile: u32,
     pub pad1: u32,
 }

@@ -56,9 +56,10 @@ pub struct ShadeInputs<'a> {
     pub point_spread: &'a Buffer,
     /// The object's Sd table (`gpu::SdTable`: the classical dipole's or beam diffusion's).
     pub sd_table: &'a Buffer,
-    /// The tile-cut pass's lists (headers and entries).
+    /// The tile-cut pass's lists (headers and entries), and their tiles' pixels per side.
     pub tile_headers: &'a Buffer,
     pub tile_entries: &'a Buffer,
+    pub list_tile: u32,
 }
 
 /// One piece of a frame's shading: a rectangle of pixels and, for brute force, a range of points.
@@ -273,7 +274,7 @@ impl ShadePass {
             Bind::StorageImageRead(inputs.albedo),
         ];
         let mut c = *constants;
-        c.point_range = glam::UVec4::new(unit.first_point, unit.point_count, unit.object, 0);
+        c.point_range = glam::UVec4::new(unit.first_point, unit.point_count, unit.object, inputs.list_tile);
         let additive = unit.point_count > 0;
         let pipeline = self
             .shading

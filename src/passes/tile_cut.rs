@@ -1,4 +1,4 @@
-//! The tile-cut pass (shaders/tile_cut.comp): per screen tile of `TILE_SIZE`² pixels, the list of
+//! The tile-cut pass (shaders/tile_cut.comp): per screen tile of 4² or 8² pixels, the list of
 //! tree nodes and points that are far and small enough for every pixel of the tile, so that the
 //! shade pass's lanes for a tile evaluate the same sources in step. Reads: the object's and the frame's parameters,
 //! tree nodes, sorted points, the G-buffer's positions. Writes: tile headers, list entries, the
@@ -8,9 +8,28 @@ use crate::error::Result;
 use crate::gpu::TileCutConstants;
 use crate::vk::{Bind, Buffer, BufferUsageFlags, Context, Image, MemoryLocation, Pipeline, Recorder};
 
-pub use crate::gpu::{TILE_SIZE, WALK_FROM_ROOT};
+pub use crate::gpu::{LIST_TILE_SIZES, WALK_FROM_ROOT};
 /// List entries allotted per tile before a frame has told how many it needs.
 const INITIAL_ENTRIES_PER_TILE: u64 = 256;
+
+/// Pixels per side of an object's list tiles for a frame. A tile's list opens every node that
+/// any of its pixels must open, so where a tile spans several point spacings on the object its
+/// pixels evaluate many points that each alone would have taken as one node: there the small
+/// tile (4) wins, the large one (8) elsewhere, as it walks the tree for 4x the pixels. Measured
+/// frame times (llvmpipe, BENCHMARKS.md "A clean frame"): the default bunny at 256² 983 → 320 ms,
+/// at 512² 853 → 610 ms (an 8x8 tile 3-4 spacings wide); pbrt-v2's sphere at 1024² 2077 →
+/// 2653 ms (0.5 spacings), 512² 563 → 708 ms (1.05), 256² 375 → 219 ms (2.1). The small tile
+/// needs the device's subgroups to fit in it: a warp over two tiles would run both lists.
+/// `pixel_footprint`: a pixel's width at the object (scene units); `point_spacing` the same.
+pub fn list_tile(pixel_footprint: f32, point_spacing: f32, subgroup_size: u32) -> u32 {
+    let [small, large] = LIST_TILE_SIZES;
+    let spans = large as f32 * pixel_footprint / point_spacing;
+    if subgroup_size <= small * small && spans > 1.5 {
+        small
+    } else {
+        large
+    }
+}
 
 /// The lists of one frame size: a header per tile, the entries, and the allocation counter the
 /// host reads to learn whether every list fitted.
@@ -22,18 +41,28 @@ pub struct TileLists {
     pub capacity: u64,
     /// The most entries the lists may grow to (the device's limit unless set lower).
     limit: u64,
+    /// Pixels per side of a tile this frame (`list_tile`), and the tiles across and down.
+    pub list_tile: u32,
     pub tiles: [u32; 2],
     pixels: [u32; 2],
 }
 
 impl TileLists {
-    /// Lists for a `width` x `height` image holding `capacity` entries (by default 256 per tile),
-    /// which may grow up to `limit` entries (by default the device's limit).
-    pub fn new(ctx: &Context, width: u32, height: u32, capacity: Option<u64>, limit: Option<u64>) -> Result<TileLists> {
-        let tiles = [width.div_ceil(TILE_SIZE), height.div_ceil(TILE_SIZE)];
-        let tile_count = tiles[0] as u64 * tiles[1] as u64;
+    /// Lists for a `width` x `height` image in tiles of `list_tile` pixels a side, holding
+    /// `capacity` entries (by default 256 per tile), which may grow up to `limit` entries (by
+    /// default the device's limit); headers for the smaller tiles, so that a later frame may use
+    /// either size.
+    pub fn new(
+        ctx: &Context,
+        (width, height): (u32, u32),
+        list_tile: u32,
+        capacity: Option<u64>,
+        limit: Option<u64>,
+    ) -> Result<TileLists> {
+        let tiles_of = |size: u32| width.div_ceil(size) as u64 * height.div_ceil(size) as u64;
         let limit = limit.unwrap_or(u64::MAX).clamp(4, max_entries(ctx));
-        let capacity = capacity.unwrap_or(tile_count * INITIAL_ENTRIES_PER_TILE).clamp(4, limit);
+        let capacity = capacity.unwrap_or(tiles_of(list_tile) * INITIAL_ENTRIES_PER_TILE).clamp(4, limit);
+        let tile_count = tiles_of(LIST_TILE_SIZES[0]);
         // TRANSFER_DST: frames without a cut clear the headers.
         let usage =
             BufferUsageFlags::STORAGE_BUFFER | BufferUsageFlags::UNIFORM_TEXEL_BUFFER | BufferUsageFlags::TRANSFER_DST;
@@ -56,9 +85,17 @@ impl TileLists {
             )?,
             capacity,
             limit,
-            tiles,
+            list_tile,
+            tiles: [width.div_ceil(list_tile), height.div_ceil(list_tile)],
             pixels: [width, height],
         })
+    }
+
+    /// Tiles of `size` pixels a side (one of `LIST_TILE_SIZES`) from the next cut on.
+    pub fn set_list_tile(&mut self, size: u32) {
+        debug_assert!(LIST_TILE_SIZES.contains(&size));
+        self.list_tile = size;
+        self.tiles = [self.pixels[0].div_ceil(size), self.pixels[1].div_ceil(size)];
     }
 
     /// Entries the last cut asked for (all tiles, whether they fitted or not).
@@ -75,7 +112,24 @@ impl TileLists {
             return Ok(None);
         }
         let capacity = (needed + needed / 4).min(self.limit);
-        Ok(Some(TileLists::new(ctx, self.pixels[0], self.pixels[1], Some(capacity), Some(self.limit))?))
+        let size = (self.pixels[0], self.pixels[1]);
+        Ok(Some(TileLists::new(ctx, size, self.list_tile, Some(capacity), Some(self.limit))?))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The small tile where the large one spans more than 1.5 spacings and a subgroup fits in 16
+    /// pixels (llvmpipe's 8 lanes, not a 32-lane warp).
+    #[test]
+    fn list_tile_follows_the_footprint_and_the_subgroup() {
+        assert_eq!(list_tile(0.1, 1.0, 8), 8, "0.8 spacings");
+        assert_eq!(list_tile(0.2, 1.0, 8), 4, "1.6 spacings");
+        assert_eq!(list_tile(0.2, 1.0, 16), 4);
+        assert_eq!(list_tile(0.2, 1.0, 32), 8, "a warp spans 32 pixels");
+        assert_eq!(list_tile(5.0, 1.0, 64), 8);
     }
 }
 
@@ -111,7 +165,7 @@ impl TileCutPass {
             pixels: lists.pixels,
             capacity: lists.capacity.min(u32::MAX as u64) as u32,
             object,
-            pad0: 0,
+            list_tile: lists.list_tile,
             pad1: 0,
         };
         rec.dispatch(

@@ -134,6 +134,8 @@ pub struct Context {
     /// Bits of a timestamp that are valid on the queue; 0 means no timestamps.
     pub timestamp_valid_bits: u32,
     pub has_shader_int64: bool,
+    /// Lanes of a subgroup (a SIMD group on llvmpipe, a warp or wave on a GPU).
+    pub subgroup_size: u32,
     counts: Arc<ValidationCounts>,
     pub validation: bool,
     pub(crate) commands: super::submit::CommandsCell,
@@ -429,6 +431,11 @@ impl Context {
         let (queue_family, timestamp_valid_bits) = find_queue_family(&instance, pd).expect("checked by choose_device");
         // SAFETY: valid physical device.
         let properties = unsafe { instance.get_physical_device_properties(pd) };
+        let mut subgroup = vk::PhysicalDeviceSubgroupProperties::default();
+        let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut subgroup);
+        // SAFETY: as above; `subgroup` outlives the call.
+        unsafe { instance.get_physical_device_properties2(pd, &mut props2) };
+        let subgroup_size = subgroup.subgroup_size.max(1);
 
         // Check the features we rely on before asking for them, to name what is missing.
         let mut have13 = vk::PhysicalDeviceVulkan13Features::default();
@@ -533,6 +540,7 @@ impl Context {
             info,
             timestamp_valid_bits,
             has_shader_int64,
+            subgroup_size,
             counts,
             validation,
             commands: std::cell::RefCell::new(commands),
