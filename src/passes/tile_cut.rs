@@ -117,22 +117,6 @@ impl TileLists {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The small tile where the large one spans more than 1.5 spacings and a subgroup fits in 16
-    /// pixels (llvmpipe's 8 lanes, not a 32-lane warp).
-    #[test]
-    fn list_tile_follows_the_footprint_and_the_subgroup() {
-        assert_eq!(list_tile(0.1, 1.0, 8), 8, "0.8 spacings");
-        assert_eq!(list_tile(0.2, 1.0, 8), 4, "1.6 spacings");
-        assert_eq!(list_tile(0.2, 1.0, 16), 4);
-        assert_eq!(list_tile(0.2, 1.0, 32), 8, "a warp spans 32 pixels");
-        assert_eq!(list_tile(5.0, 1.0, 64), 8);
-    }
-}
-
 /// The most list entries: one storage buffer, and its texel view (4 entries per texel).
 fn max_entries(ctx: &Context) -> u64 {
     let limits = ctx.limits();
@@ -184,5 +168,21 @@ impl TileCutPass {
             [lists.tiles[0].div_ceil(8), lists.tiles[1], 1],
         )?;
         rec.host_read(&lists.allocation)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The small tile where the large one spans more than 1.5 spacings and a subgroup fits in 16
+    /// pixels (llvmpipe's 8 lanes, not a 32-lane warp).
+    #[test]
+    fn list_tile_follows_the_footprint_and_the_subgroup() {
+        assert_eq!(list_tile(0.1, 1.0, 8), 8, "0.8 spacings");
+        assert_eq!(list_tile(0.2, 1.0, 8), 4, "1.6 spacings");
+        assert_eq!(list_tile(0.2, 1.0, 16), 4);
+        assert_eq!(list_tile(0.2, 1.0, 32), 8, "a warp spans 32 pixels");
+        assert_eq!(list_tile(5.0, 1.0, 64), 8);
     }
 }
