@@ -8,8 +8,8 @@
 // finer one, never coarser; a node that some pixel must open is opened for all of them, down to
 // points (leaves), evaluated singly. Every pixel thus evaluates the same list in step: handing
 // the nodes near the tile to each pixel's own walk instead (a private stack per lane, divergent)
-// made that walk 80% of the default frame's shade pass, where the finer common list costs 22% more
-// evaluations (measured: BENCHMARKS.md, "A clean frame"). The walk runs twice: once to count, then, after
+// made that walk three quarters of the default frame's shade pass, where the finer common list
+// costs 22% more evaluations (BENCHMARKS.md, "A clean frame"). The walk runs twice: once to count, then, after
 // one atomic allocation in the list buffer, to write; a tile whose list does not fit is marked
 // for a walk from the root per pixel (the host then grows the buffer for the next try).
 #include "points.glsl"
