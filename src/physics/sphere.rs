@@ -21,7 +21,7 @@ impl Rng {
     }
 
     /// Uniform in (0, 1).
-    pub fn next(&mut self) -> f64 {
+    pub fn uniform(&mut self) -> f64 {
         self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = self.0;
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
@@ -70,13 +70,13 @@ pub fn walk(
     let centre = DVec3::new(0.0, 0.0, -radius);
     let mut scatterings = 0u32;
     loop {
-        let s = -rng.next().ln();
+        let s = -rng.uniform().ln();
         let t = distance_out(radius, p, d);
         if s >= t {
             p += t * d;
             let n = (p - centre).normalize();
             let cos = d.dot(n).clamp(0.0, 1.0);
-            if rng.next() < fresnel::reflectance(1.0 / eta, cos) {
+            if rng.uniform() < fresnel::reflectance(1.0 / eta, cos) {
                 d = (d - 2.0 * d.dot(n) * n).normalize();
                 continue;
             }
@@ -89,12 +89,12 @@ pub fn walk(
             return scatterings;
         }
         p += s * d;
-        if rng.next() >= albedo || scatterings >= max_collisions {
+        if rng.uniform() >= albedo || scatterings >= max_collisions {
             return scatterings;
         }
         scatterings += 1;
-        let mu = 2.0 * rng.next() - 1.0;
-        let phi = 2.0 * PI * rng.next();
+        let mu = 2.0 * rng.uniform() - 1.0;
+        let phi = 2.0 * PI * rng.uniform();
         let st = (1.0 - mu * mu).max(0.0).sqrt();
         d = DVec3::new(st * phi.cos(), st * phi.sin(), mu);
     }
@@ -289,10 +289,10 @@ pub struct View {
 /// sphere; None if it misses it or is reflected there (the boundary's own reflection, which the
 /// reference subtracts), else the entry point and the refracted direction.
 fn launch(rng: &mut Rng, eta: f64, radius: f64, beam: &Beam) -> Option<(DVec3, DVec3)> {
-    let (r, phi) = (beam.hole * rng.next().sqrt(), 2.0 * PI * rng.next());
+    let (r, phi) = (beam.hole * rng.uniform().sqrt(), 2.0 * PI * rng.uniform());
     let p = DVec3::new(r * phi.cos(), r * phi.sin(), beam.height);
-    let cos2 = 1.0 - rng.next() * beam.cone.sin().powi(2);
-    let (ct, st, psi) = (cos2.sqrt(), (1.0 - cos2).max(0.0).sqrt(), 2.0 * PI * rng.next());
+    let cos2 = 1.0 - rng.uniform() * beam.cone.sin().powi(2);
+    let (ct, st, psi) = (cos2.sqrt(), (1.0 - cos2).max(0.0).sqrt(), 2.0 * PI * rng.uniform());
     let d = DVec3::new(st * psi.cos(), st * psi.sin(), -ct);
     // The near root of |p + t d − c|² = R² from outside.
     let b = p.dot(d) + radius * d.z;
@@ -304,7 +304,7 @@ fn launch(rng: &mut Rng, eta: f64, radius: f64, beam: &Beam) -> Option<(DVec3, D
     let x = p + c / (-b + disc.sqrt()) * d;
     let n = (x - DVec3::new(0.0, 0.0, -radius)).normalize();
     let cos_i = (-d.dot(n)).clamp(0.0, 1.0);
-    if rng.next() < fresnel::reflectance(eta, cos_i) {
+    if rng.uniform() < fresnel::reflectance(eta, cos_i) {
         return None;
     }
     let cos_t = (1.0 - (1.0 - cos_i * cos_i) / (eta * eta)).max(0.0).sqrt();
