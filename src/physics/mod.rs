@@ -13,6 +13,7 @@ pub mod halfspace;
 pub mod mc_profile;
 pub mod microfacet;
 pub mod slab_profile;
+pub mod sphere;
 
 /// Which diffusion coefficient the directional dipole uses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
