@@ -195,11 +195,13 @@ impl RteTally {
     }
 }
 
-/// SplitMix64: a small, fast, reproducible generator for the Monte Carlo.
-struct SplitMix(u64);
+/// SplitMix64: a small, fast, reproducible generator for the Monte Carlo (the half-space's, the
+/// slab's and the sphere's walks).
+pub(crate) struct SplitMix(pub(crate) u64);
 
 impl SplitMix {
-    fn next(&mut self) -> f64 {
+    /// Uniform in (0, 1).
+    pub(crate) fn next(&mut self) -> f64 {
         self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = self.0;
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);

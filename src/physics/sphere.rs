@@ -12,24 +12,7 @@ use super::{fresnel, halfspace};
 use glam::DVec3;
 use std::f64::consts::PI;
 
-/// SplitMix64 (as in halfspace.rs, whose generator is private).
-pub struct Rng(u64);
-
-impl Rng {
-    pub fn new(seed: u64) -> Rng {
-        Rng(seed)
-    }
-
-    /// Uniform in (0, 1).
-    pub fn uniform(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        ((z >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-    }
-}
+use halfspace::SplitMix as Rng;
 
 /// Where a photon left the sphere: its exit point relative to the pole (mean free paths), its
 /// direction outside (refracted), cos²θo outside to the local normal, the geodesic distance
@@ -59,7 +42,7 @@ fn distance_out(radius: f64, p: DVec3, d: DVec3) -> f64 {
 /// 1 − `albedo` at each collision (and after `max_collisions`), isotropic scattering, and at the
 /// surface Fresnel reflection or escape with refraction, which `on_escape` is told. Returns the
 /// scatterings.
-pub fn walk(
+fn walk(
     rng: &mut Rng,
     (albedo, eta, radius): (f64, f64, f64),
     mut p: DVec3,
@@ -70,13 +53,13 @@ pub fn walk(
     let centre = DVec3::new(0.0, 0.0, -radius);
     let mut scatterings = 0u32;
     loop {
-        let s = -rng.uniform().ln();
+        let s = -rng.next().ln();
         let t = distance_out(radius, p, d);
         if s >= t {
             p += t * d;
             let n = (p - centre).normalize();
             let cos = d.dot(n).clamp(0.0, 1.0);
-            if rng.uniform() < fresnel::reflectance(1.0 / eta, cos) {
+            if rng.next() < fresnel::reflectance(1.0 / eta, cos) {
                 d = (d - 2.0 * d.dot(n) * n).normalize();
                 continue;
             }
@@ -89,12 +72,12 @@ pub fn walk(
             return scatterings;
         }
         p += s * d;
-        if rng.uniform() >= albedo || scatterings >= max_collisions {
+        if rng.next() >= albedo || scatterings >= max_collisions {
             return scatterings;
         }
         scatterings += 1;
-        let mu = 2.0 * rng.uniform() - 1.0;
-        let phi = 2.0 * PI * rng.uniform();
+        let mu = 2.0 * rng.next() - 1.0;
+        let phi = 2.0 * PI * rng.next();
         let st = (1.0 - mu * mu).max(0.0).sqrt();
         d = DVec3::new(st * phi.cos(), st * phi.sin(), mu);
     }
@@ -113,7 +96,7 @@ pub fn trace_sphere(
     (seed, max_collisions): (u64, u32),
     mut on_escape: impl FnMut(&SphereEscape),
 ) -> u64 {
-    let mut rng = Rng::new(seed);
+    let mut rng = Rng(seed);
     (0..photons)
         .map(|_| walk(&mut rng, (albedo, eta, radius), DVec3::ZERO, start, max_collisions, &mut on_escape) as u64)
         .sum()
@@ -289,10 +272,10 @@ pub struct View {
 /// sphere; None if it misses it or is reflected there (the boundary's own reflection, which the
 /// reference subtracts), else the entry point and the refracted direction.
 fn launch(rng: &mut Rng, eta: f64, radius: f64, beam: &Beam) -> Option<(DVec3, DVec3)> {
-    let (r, phi) = (beam.hole * rng.uniform().sqrt(), 2.0 * PI * rng.uniform());
+    let (r, phi) = (beam.hole * rng.next().sqrt(), 2.0 * PI * rng.next());
     let p = DVec3::new(r * phi.cos(), r * phi.sin(), beam.height);
-    let cos2 = 1.0 - rng.uniform() * beam.cone.sin().powi(2);
-    let (ct, st, psi) = (cos2.sqrt(), (1.0 - cos2).max(0.0).sqrt(), 2.0 * PI * rng.uniform());
+    let cos2 = 1.0 - rng.next() * beam.cone.sin().powi(2);
+    let (ct, st, psi) = (cos2.sqrt(), (1.0 - cos2).max(0.0).sqrt(), 2.0 * PI * rng.next());
     let d = DVec3::new(st * psi.cos(), st * psi.sin(), -ct);
     // The near root of |p + t d − c|² = R² from outside.
     let b = p.dot(d) + radius * d.z;
@@ -304,7 +287,7 @@ fn launch(rng: &mut Rng, eta: f64, radius: f64, beam: &Beam) -> Option<(DVec3, D
     let x = p + c / (-b + disc.sqrt()) * d;
     let n = (x - DVec3::new(0.0, 0.0, -radius)).normalize();
     let cos_i = (-d.dot(n)).clamp(0.0, 1.0);
-    if rng.uniform() < fresnel::reflectance(eta, cos_i) {
+    if rng.next() < fresnel::reflectance(eta, cos_i) {
         return None;
     }
     let cos_t = (1.0 - (1.0 - cos_i * cos_i) / (eta * eta)).max(0.0).sqrt();
@@ -327,7 +310,7 @@ pub fn beam_view(
     let mut counts = vec![0u64; n * n];
     let cos_cone = view.cone.cos();
     let pixel = 2.0 * view.half_extent / n as f64;
-    let mut rng = Rng::new(seed);
+    let mut rng = Rng(seed);
     let mut on_escape = |e: &SphereEscape| {
         if e.direction.z < cos_cone {
             return;
