@@ -66,6 +66,23 @@ layout(binding = 16) uniform sampler2DArray shadow_depth;
 layout(binding = 17, rgba32f) uniform readonly image2D surface_albedo;
 vec4 dipole_header; // its texel 0, read once per pixel
 vec4 slab_header; // the Monte Carlo table's slab header (L in mm, scales), read once per pixel (0 for the other models)
+// The Monte Carlo table's curvature rows at the pixel's mean curvature (curvature_rows): every
+// pair of the pixel is read as on a sphere (or cavity) of the pixel's curvature, smoothed over
+// the longest diffusion length so that its sources' is nearly the same.
+vec4 pixel_curvature_rows;
+float pixel_curvature_mm = 0.0;
+// The Monte Carlo table's oblique-entry shift per channel (table_entry_shift), read once.
+vec3 entry_shift_mm = vec3(0.0);
+
+// The Monte Carlo table's multiple scattering at xo from a source at xi whose light entered
+// along mean refracted directions with tangential parts `along[c]` (per channel; length sin θt
+// for one light, shorter where lights differ): Sp at |xo − (xi + δ_c·along_c)| per channel,
+// times the curvature ratio at the chord |xo − xi|. `d` = xo − xi in mm.
+vec3 mc_sd(vec3 d, vec3 along[3]) {
+    vec3 r = vec3(length(d - entry_shift_mm.x * along[0]), length(d - entry_shift_mm.y * along[1]),
+                  length(d - entry_shift_mm.z * along[2]));
+    return sd_table_per_channel(dipole_table, dipole_header, r) * curvature_ratio(dipole_table, pixel_curvature_rows, length(d));
+}
 
 const uint STACK_SIZE = 96u;
 // Points nearer than this many diffusion lengths (1/σtr) of the farthest-reaching channel are
@@ -118,7 +135,9 @@ vec3 across(vec3 xi, vec3 ni, vec3 xo, vec3 no, vec3 sd, vec3 power_mm) {
     float t = dot(d, no);
     if (t <= 0.0) return sd;
     float rho = length(d - t * no);
-    w = min(w, 1.0);
+    // Across a ball the measured sphere's transport (the curvature ratio) holds: a pair across
+    // a sphere of radius R is at least R deep (κt ≥ 1), across a flat slab κ = 0.
+    w = min(w, 1.0) * (1.0 - clamp(pixel_curvature_mm * t, 0.0, 1.0));
     vec3 through = w * slab_transmission(dipole_table, slab_header, rho, t) * power_mm;
     across_sum += through;
     float luminance = dot(through, vec3(0.2126, 0.7152, 0.0722));
@@ -137,9 +156,13 @@ vec3 source(vec3 xi, vec3 ni, vec3 wi, vec3 power, vec3 xo, vec3 no) {
         sd = vec3(dirpole_channel_sd(object_params.channels[0], g, xi_mm, xo_mm, no),
                   dirpole_channel_sd(object_params.channels[1], g, xi_mm, xo_mm, no),
                   dirpole_channel_sd(object_params.channels[2], g, xi_mm, xo_mm, no));
+    } else if (MODEL == MODEL_MC) {
+        // One light: its refracted direction's part along the surface, −(wi − (wi·ni)ni)/η.
+        vec3 t = -(wi - dot(wi, ni) * ni) / object_params.channels[0].eta;
+        vec3 along[3] = vec3[](t, t, t);
+        sd = across(xi, ni, xo, no, mc_sd((xo - xi) * s, along), power * (s * s));
     } else {
         sd = dipole_sd_table(dipole_table, dipole_header, length(xo - xi) * s);
-        if (MODEL == MODEL_MC) sd = across(xi, ni, xo, no, sd, power * (s * s));
     }
     return sd * power * (s * s); // power is irradiance × scene-unit area: to mm²
 }
@@ -165,9 +188,19 @@ vec3 merged_source(vec3 xi, vec3 ni, vec3 power, vec4 incident[3], vec3 dw, vec3
         sd.x = dirpole_channel_sd(object_params.channels[0], g, xi_mm, xo_mm, no);
         sd.y = dirpole_channel_sd(object_params.channels[1], with_refracted(g, w[1], no), xi_mm, xo_mm, no);
         sd.z = dirpole_channel_sd(object_params.channels[2], with_refracted(g, w[2], no), xi_mm, xo_mm, no);
+    } else if (MODEL == MODEL_MC) {
+        // Each channel's mean refracted direction's part along the surface: −(Σωi's)/η per
+        // unit power (the merged record's, as the directional dipole's above).
+        float inv_eta = 1.0 / object_params.channels[0].eta;
+        vec3 along[3];
+        for (uint c = 0u; c < 3u; ++c) {
+            vec3 t = incident[c].xyz - dot(incident[c].xyz, ni) * ni;
+            along[c] = power[c] > 0.0 ? -t * (inv_eta / power[c]) : vec3(0.0);
+        }
+        sd = mc_sd((xo - xi) * s, along);
+        if (across_object) sd = across(xi, ni, xo, no, sd, power * (s * s));
     } else {
         sd = dipole_sd_table(dipole_table, dipole_header, length(xo - xi) * s);
-        if (MODEL == MODEL_MC && across_object) sd = across(xi, ni, xo, no, sd, power * (s * s));
     }
     return sd * power * (s * s); // power is irradiance × scene-unit area: to mm²
 }
@@ -244,7 +277,7 @@ float near_correction(vec3 xi, vec3 ni, float area, vec3 xo, vec3 no, inout uint
 // The integral is a fixed quadrature over the disk (this function). Radially: Gauss–Legendre on
 // [0, start] in t, r = scale · sinh t (r dr = scale² sinh t cosh t dt: smooth where Sd peaks
 // over ~D, and where Sd ~ 1/r for beam diffusion's single scattering), and on [start, end],
-// where 1 − w falls smoothly to 0. Angularly (the directional dipole only; the tables are
+// where 1 − w falls smoothly to 0. Angularly (the directional dipole and the Monte Carlo table, whose sources shift; the other tables are
 // radial): NEAR_ANGLES angles on the half circle from the lights' mean tangential direction,
 // each standing for its mirror image too (the source is symmetric about the plane of the normal
 // and the refracted light). The quadrature's error against a fine f64 grid: within 0.015%
@@ -286,7 +319,8 @@ vec3 near_field(vec3 xo, vec3 no, out uint made) {
         ? normalize(tangential)
         : normalize(cross(no, abs(no.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0)));
     vec3 t2 = cross(no, t1);
-    uint angles = MODEL == MODEL_DIRECTIONAL ? NEAR_ANGLES : 1u;
+    // The Monte Carlo table's sources are shifted along the light's direction: not radial either.
+    uint angles = MODEL == MODEL_DIRECTIONAL || MODEL == MODEL_MC ? NEAR_ANGLES : 1u;
     float t_end = asinh(start / scale);
     vec3 sum = vec3(0.0);
     for (uint j = 0u; j < 10u; ++j) {
@@ -570,10 +604,15 @@ void main() {
     // Another object's pixel: its own draw shades it.
     if (surface.w != float(pc.point_range.z + 1u)) discard;
     vec3 xo = surface.xyz;
-    vec3 no = normalize(imageLoad(surface_normal, pixel).xyz);
+    vec4 normal_curvature = imageLoad(surface_normal, pixel);
+    vec3 no = normalize(normal_curvature.xyz);
     own_weight = imageLoad(surface_albedo, pixel).rgb;
     dipole_header = dipole_table_header(dipole_table);
     slab_header = MODEL == MODEL_MC ? slab_header_of(dipole_table) : vec4(0.0);
+    if (MODEL == MODEL_MC) entry_shift_mm = table_entry_shift(dipole_table);
+    if (MODEL == MODEL_MC) pixel_curvature_mm = normal_curvature.w / object_params.mm_per_unit;
+    pixel_curvature_rows = MODEL == MODEL_MC ? curvature_rows(dipole_table, pixel_curvature_mm)
+                                             : vec4(0.0, 0.0, 0.0, 1.0);
     vec3 wo = normalize(pc.eye.xyz - xo);
     vec3 sum = vec3(0.0);
     uint visits = 0u;

@@ -577,14 +577,17 @@ impl Renderer {
         let inputs: Vec<ShadeInputs> = (0..objects).map(|k| shade_inputs!(self, k)).collect();
         // Every object's draw into the G-buffer: the translucent ones (ids from 0), then the
         // opaque ones.
-        let translucent_meshes = w.objects.iter().map(|o| (&o.vertices, &o.indices, o.index_count, &o.texture));
-        let opaque_surfaces = w.opaque.iter().map(|o| (&o.vertices, &o.indices, o.index_count, &o.texture));
+        let translucent_meshes =
+            w.objects.iter().map(|o| (&o.vertices, &o.indices, o.index_count, &o.texture, &o.curvature));
+        let opaque_surfaces =
+            w.opaque.iter().map(|o| (&o.vertices, &o.indices, o.index_count, &o.texture, &o.curvature));
         let surfaces: Vec<SurfaceDraw> = (translucent_meshes.chain(opaque_surfaces).enumerate())
-            .map(|(id, (vertices, indices, index_count, texture))| SurfaceDraw {
+            .map(|(id, (vertices, indices, index_count, texture, curvature))| SurfaceDraw {
                 vertices,
                 indices,
                 index_count,
                 uvs: &texture.uvs,
+                curvature,
                 texture: (&texture.image, &texture.sampler),
                 constants: texture.surface_constants(view_projection, id as u32),
             })

@@ -9,14 +9,14 @@ use crate::bad_input;
 use crate::budget::{self, FrameSizes};
 use crate::error::Result;
 use crate::frame_desc::FrameDesc;
-use crate::gpu::sd_table::{AngularFactors, SlabTransmission};
+use crate::gpu::sd_table::{AngularFactors, CurvatureRatios, SlabTransmission};
 use crate::gpu::{GpuChannel, ObjectParams, SdTable, SurfaceConstants};
 use crate::hierarchy::{self, Hierarchy, HierarchyOptions};
 use crate::materials::{Material, ScatterWeight};
 use crate::mesh::Mesh;
 use crate::physics::beam_diffusion::BeamMedium;
 use crate::physics::mc_profile::McProfile;
-use crate::physics::slab_profile;
+use crate::physics::{curvature_profile, slab_profile};
 use crate::physics::{Diffusion, Model};
 use crate::scene::Light;
 use crate::shadows::Shadows;
@@ -40,6 +40,10 @@ pub struct GpuObject {
     pub sd_table: Buffer,
     /// Its texture's scatter weight (1 everywhere without one).
     pub texture: SurfaceTexture,
+    /// Per vertex, its mean curvature smoothed over the material's longest diffusion length
+    /// (1/scene unit, `mesh::curvature`), for the Monte Carlo table's curvature ratios (zeros
+    /// for the other models, which do not read it).
+    pub curvature: Buffer,
     /// The mean distance between its sample points, √(area / points), in scene units.
     pub point_spacing: f32,
     /// What the buffers above were made from.
@@ -182,6 +186,8 @@ pub struct GpuOpaque {
     pub vertices: Buffer,
     pub indices: Buffer,
     pub index_count: u32,
+    /// Zeros per vertex: the surface pass's curvature, which only translucent objects use.
+    pub curvature: Buffer,
     /// Its reflectance.
     pub texture: SurfaceTexture,
     pub bounds: (Vec3, Vec3),
@@ -195,7 +201,9 @@ impl GpuOpaque {
         let (vertices, indices, index_count) = upload_mesh(ctx, &mesh)?;
         let texture = SurfaceTexture::new(ctx, &opaque.reflectance, opaque.uvs.as_deref(), mesh.positions.len())?;
         let bounds = mesh.bounds();
-        Ok(GpuOpaque { vertices, indices, index_count, texture, bounds, made_from: opaque.clone() })
+        let zeros = vec![0.0f32; mesh.positions.len().max(1)];
+        let curvature = vk::upload_buffer(ctx, "no curvature", &zeros, BufferUsageFlags::STORAGE_BUFFER)?;
+        Ok(GpuOpaque { vertices, indices, index_count, curvature, texture, bounds, made_from: opaque.clone() })
     }
 }
 
@@ -348,6 +356,9 @@ impl GpuWorld {
                 (g.made_from.diffusion, g.made_from.mm_per_unit) = (diffusion, world.mm_per_unit);
                 g.made_from.table = table;
                 g.point_spacing = write_params(&mut g.params, &mut g.sd_table, &g.made_from, point_count)?;
+                // Its smoothing length is the material's, in scene units.
+                ctx.wait_idle()?;
+                g.curvature = curvature_buffer(ctx, &g.made_from)?;
             }
         }
         self.sync_opaque(ctx, world, desc, (relayout, shadow_resolution), bounds.into_iter().reduce(union))?;
@@ -435,11 +446,16 @@ impl GpuObject {
             ctx,
             "Sd table",
             // A header texel, TABLE_SIZE - 1 pairs, the angular factors and the slab's transmission.
-            ((crate::gpu::sd_table::TABLE_SIZE + AngularFactors::TEXELS + SlabTransmission::TEXELS) * 16) as u64,
+            ((crate::gpu::sd_table::TABLE_SIZE
+                + AngularFactors::TEXELS
+                + SlabTransmission::TEXELS
+                + CurvatureRatios::TEXELS)
+                * 16) as u64,
             BufferUsageFlags::UNIFORM_TEXEL_BUFFER,
             MemoryLocation::CpuToGpu,
         )?;
         let point_spacing = write_params(&mut params, &mut sd_table, &made_from, options.point_count)?;
+        let curvature = curvature_buffer(ctx, &made_from)?;
         Ok(GpuObject {
             hierarchy,
             vertices,
@@ -449,10 +465,25 @@ impl GpuObject {
             params,
             sd_table,
             texture,
+            curvature,
             point_spacing,
             made_from,
         })
     }
+}
+
+/// Per vertex of an object's mesh, its mean curvature for the Monte Carlo table (smoothed over
+/// the material's longest diffusion length, in scene units), zeros for the other models.
+fn curvature_buffer(ctx: &Context, from: &MadeFrom) -> Result<Buffer> {
+    let n = from.mesh.positions.len().max(1);
+    let values = if from.table == TableProfile::MonteCarlo {
+        let media = [0, 1, 2].map(|c| from.material.channel(c));
+        let radius = curvature_profile::unit_of(&media) as f32 / from.mm_per_unit;
+        crate::mesh::curvature::smoothed_mean_curvature(&from.mesh, radius)
+    } else {
+        vec![0.0; n]
+    };
+    vk::upload_buffer(ctx, "mean curvature", &values, BufferUsageFlags::STORAGE_BUFFER)
 }
 
 /// The vertex and index buffers of `mesh`, and its index count.
@@ -486,32 +517,41 @@ fn write_params(params: &mut Buffer, table: &mut Buffer, from: &MadeFrom, point_
             pad: 0.0,
         }],
     )?;
-    let (sd_table, factors, across) = match from.table {
-        TableProfile::Dipole => {
-            (SdTable::dipole(&[0, 1, 2].map(constants)), AngularFactors::none(), SlabTransmission::none())
-        }
+    let (sd_table, factors, across, curvature) = match from.table {
+        TableProfile::Dipole => (
+            SdTable::dipole(&[0, 1, 2].map(constants)),
+            AngularFactors::none(),
+            SlabTransmission::none(),
+            CurvatureRatios::none(),
+        ),
         TableProfile::BeamDiffusion => (
             SdTable::beam_diffusion(&[0, 1, 2].map(|c| BeamMedium::new(&from.material.channel(c)))),
             AngularFactors::none(),
             SlabTransmission::none(),
+            CurvatureRatios::none(),
         ),
         TableProfile::MonteCarlo => {
             let media = [0, 1, 2].map(|c| from.material.channel(c));
-            let (profiles, slabs) = std::thread::scope(|s| {
+            let (profiles, slabs, curved) = std::thread::scope(|s| {
                 let slabs = s.spawn(|| slab_profile::of_channels(&media));
+                let curved = s.spawn(|| curvature_profile::of_channels(&media));
                 let profiles = McProfile::of_channels(&media);
-                (profiles, slabs.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+                let slabs = slabs.join().unwrap_or_else(|e| std::panic::resume_unwind(e));
+                (profiles, slabs, curved.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
             });
             (
                 SdTable::monte_carlo(&profiles, &[0, 1, 2].map(constants)),
                 AngularFactors::monte_carlo(&profiles),
                 SlabTransmission::monte_carlo(&slabs),
+                CurvatureRatios::monte_carlo(&curved),
             )
         }
     };
     table.write(0, &sd_table.texels())?;
     let factors_at = crate::gpu::sd_table::TABLE_SIZE * 16;
     table.write(factors_at as u64, &factors.texels())?;
-    table.write((factors_at + AngularFactors::TEXELS * 16) as u64, &across.texels())?;
+    let across_at = factors_at + AngularFactors::TEXELS * 16;
+    table.write(across_at as u64, &across.texels())?;
+    table.write((across_at + SlabTransmission::TEXELS * 16) as u64, &curvature.texels())?;
     Ok(spacing_mm / from.mm_per_unit)
 }

@@ -2,6 +2,7 @@
 //! through ply-rs-bw ([`ply`]), OFF files ([`off`]), any of them gzip-compressed, and procedural
 //! shapes. One index stream is shared by positions and normals.
 
+pub mod curvature;
 pub mod off;
 pub mod ply;
 

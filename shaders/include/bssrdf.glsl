@@ -102,6 +102,22 @@ vec3 table_exit_factor(usamplerBuffer table, float cos_t, float cos_o) {
     return h0 + (h1 - h0) * (x - i);
 }
 vec3 dipole_sd_table(usamplerBuffer table, vec4 header, float r) { return sd_table_at(table, 0, header, r); }
+// The table at a distance per channel (three lookups, each for its own channel): the Monte
+// Carlo table's sources shifted per channel (table_entry_shift).
+vec3 sd_table_per_channel(usamplerBuffer table, vec4 header, vec3 r) {
+    vec3 x = r / (r + header.w) * float(DIPOLE_TABLE_SIZE - 1u);
+    vec3 i = min(floor(x), vec3(float(DIPOLE_TABLE_SIZE - 2u)));
+    vec2 red = unpackHalf2x16(texelFetch(table, int(i.x) + 1).x);
+    vec2 green = unpackHalf2x16(texelFetch(table, int(i.y) + 1).y);
+    vec2 blue = unpackHalf2x16(texelFetch(table, int(i.z) + 1).z);
+    return header.xyz * mix(vec3(red.x, green.x, blue.x), vec3(red.y, green.y, blue.y), x - i);
+}
+// The Monte Carlo table's oblique-entry shift δ per channel (mm per unit sin θt; mirrors
+// AngularFactors::entry_shift_mm, physics::mc_profile::McProfile::entry_shift): multiple
+// scattering from light entering along a refracted direction ω12 leaves centred on
+// xi + δ·(ω12's part along the surface), the texel after the exit factors (0 for the others).
+const int ENTRY_SHIFT_TEXEL = int(DIPOLE_TABLE_SIZE + MC_INCIDENCE_NODES * (1u + MC_EXIT_BINS));
+vec3 table_entry_shift(usamplerBuffer table) { return uintBitsToFloat(texelFetch(table, ENTRY_SHIFT_TEXEL).xyz); }
 
 // The Monte Carlo table's light across an object (mirrors gpu::sd_table::SlabTransmission and
 // physics::slab_profile::SlabChannel::sd): the transmitted profile T(ρ; t) of a flat slab of
@@ -112,7 +128,7 @@ vec3 dipole_sd_table(usamplerBuffer table, vec4 header, float r) { return sd_tab
 // node (t_k = L·2^(k/2 − 4)) MC_EXIT_BINS exit factors h_T. Between nodes: the same u, linear in
 // log t; below node 0 held; faded to 0 over the last half octave. Two fetches and one log2 per
 // pair (on lavapipe every pair pays for it: both sides of a branch run).
-const int SLAB_BASE = int(DIPOLE_TABLE_SIZE + MC_INCIDENCE_NODES * (1u + MC_EXIT_BINS));
+const int SLAB_BASE = ENTRY_SHIFT_TEXEL + 1;
 const float SLAB_FIRST_LOG2 = float(SLAB_FIRST_NODE_LOG2_PLUS_8) - 8.0;
 vec4 slab_header_of(usamplerBuffer table) { return uintBitsToFloat(texelFetch(table, SLAB_BASE)); }
 float slab_node_thickness(float k) { return exp2(0.5 * k + SLAB_FIRST_LOG2); }
@@ -152,6 +168,40 @@ vec3 slab_exit_factor(usamplerBuffer table, vec4 header, float t, float cos_o) {
     vec3 b1 = uintBitsToFloat(texelFetch(table, row + int(MC_EXIT_BINS) + 1).xyz);
     vec3 h0 = a0 + (b0 - a0) * (y - j), h1 = a1 + (b1 - a1) * (y - j);
     return h0 + (h1 - h0) * a;
+}
+
+// The Monte Carlo table's curvature ratios (mirrors gpu::sd_table::CurvatureRatios and
+// physics::curvature_profile::CurvatureChannel::ratio): C(r; κ), a sphere's (κ = 1/R > 0) or a
+// cavity's (κ < 0) multiple scattering over the half-space's at chord r, multiplying Sp(r).
+// After the light across: texel CURVATURE_BASE holds L (mm; 0: no ratios), then rows of
+// CURVATURE_ENTRIES texels (row 0 flat, 1 … N convex nodes κ_k L = 2^(k + first), N + 1 … 2N
+// concave), texel i holding entries i and i + 1 per channel as two f16 at the centres of
+// u = r/(r + L). `curvature_rows` (once per pixel): the two rows of κ (1/mm) and the second's
+// weight, linear in κ from the flat row to node 0 and in log κ between nodes, held past the
+// last; w = L. `curvature_ratio` (per pair): two fetches.
+const int CURVATURE_BASE = SLAB_BASE + 1 + int(SLAB_LOOKUP_NODES * SLAB_ENTRIES + SLAB_THICKNESS_NODES * MC_EXIT_BINS);
+const float CURVATURE_FIRST_LOG2 = float(CURVATURE_FIRST_LOG2_PLUS_8) - 8.0;
+vec4 curvature_rows(usamplerBuffer table, float kappa) {
+    float unit_mm = uintBitsToFloat(texelFetch(table, CURVATURE_BASE).x);
+    if (!(unit_mm > 0.0)) return vec4(0.0, 0.0, 0.0, 1.0);
+    float x = abs(kappa) * unit_mm;
+    if (!(x >= 0.0)) x = 0.0; // NaN: flat
+    float side = kappa < 0.0 ? float(CURVATURE_NODES) : 0.0;
+    float first = exp2(CURVATURE_FIRST_LOG2);
+    if (x < first) return vec4(0.0, 1.0 + side, x / first, unit_mm);
+    float k = min(log2(x) - CURVATURE_FIRST_LOG2, float(CURVATURE_NODES - 1u));
+    float i = min(floor(k), float(CURVATURE_NODES - 2u));
+    return vec4(1.0 + side + i, 2.0 + side + i, k - i, unit_mm);
+}
+vec3 curvature_entry(usamplerBuffer table, float row, float i, float f) {
+    uvec3 pairs = texelFetch(table, CURVATURE_BASE + 1 + int(row) * int(CURVATURE_ENTRIES) + int(i)).xyz;
+    vec2 red = unpackHalf2x16(pairs.x), green = unpackHalf2x16(pairs.y), blue = unpackHalf2x16(pairs.z);
+    return mix(vec3(red.x, green.x, blue.x), vec3(red.y, green.y, blue.y), f);
+}
+vec3 curvature_ratio(usamplerBuffer table, vec4 rows, float r_mm) {
+    float x = clamp(r_mm / (r_mm + rows.w) * float(CURVATURE_ENTRIES) - 0.5, 0.0, float(CURVATURE_ENTRIES - 1u));
+    float i = min(floor(x), float(CURVATURE_ENTRIES - 2u));
+    return mix(curvature_entry(table, rows.x, i, x - i), curvature_entry(table, rows.y, i, x - i), rows.z);
 }
 
 // The ray-source term S'(x, w, r) of the directional dipole.

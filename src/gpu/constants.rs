@@ -25,6 +25,13 @@ pub const SLAB_LOOKUP_NODES: u32 = 43;
 pub const SLAB_ENTRIES: u32 = 64;
 pub const SLAB_FIRST_NODE_LOG2_PLUS_8: u32 = 4;
 
+/// The Monte Carlo table's curvature ratios (src/physics/curvature_profile.rs's CURVATURE_NODES,
+/// ENTRIES and FIRST_CURVATURE_LOG2 + 8, checked equal in gpu::sd_table): nodes per sign of
+/// curvature, radial entries per node, node 0's log2 curvature plus 8 in units of 1/L.
+pub const CURVATURE_NODES: u32 = 8;
+pub const CURVATURE_ENTRIES: u32 = 48;
+pub const CURVATURE_FIRST_LOG2_PLUS_8: u32 = 4;
+
 /// Set in a tree node's child index when the child is a point (index into the sorted points).
 pub const LEAF_BIT: u32 = 0x8000_0000;
 
@@ -60,6 +67,9 @@ pub const GLSL_CONSTANTS: &[(&str, u32)] = &[
     ("SLAB_LOOKUP_NODES", SLAB_LOOKUP_NODES),
     ("SLAB_ENTRIES", SLAB_ENTRIES),
     ("SLAB_FIRST_NODE_LOG2_PLUS_8", SLAB_FIRST_NODE_LOG2_PLUS_8),
+    ("CURVATURE_NODES", CURVATURE_NODES),
+    ("CURVATURE_ENTRIES", CURVATURE_ENTRIES),
+    ("CURVATURE_FIRST_LOG2_PLUS_8", CURVATURE_FIRST_LOG2_PLUS_8),
     ("LEAF_BIT", LEAF_BIT),
     ("RADIX_TILE", RADIX_TILE),
     ("WALK_FROM_ROOT", WALK_FROM_ROOT),

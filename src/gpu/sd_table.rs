@@ -3,6 +3,7 @@
 //! beam diffusion's [`crate::physics::beam_diffusion::sd`] and tested against them.
 
 use crate::physics::beam_diffusion::{self, BeamMedium};
+use crate::physics::curvature_profile::{self, CurvatureChannel};
 use crate::physics::mc_profile::{self, McProfile};
 use crate::physics::slab_profile::{self, SlabChannel};
 use crate::physics::{dipole, ChannelConstants};
@@ -146,6 +147,8 @@ pub struct AngularFactors {
     pub incidence: [[f32; 3]; mc_profile::INCIDENCE_NODES],
     /// Per incidence node, per exit bin.
     pub exit: [[[f32; 3]; mc_profile::EXIT_BINS]; mc_profile::INCIDENCE_NODES],
+    /// The oblique entry's shift δ per channel (mm per unit sin θt; [`McProfile::entry_shift`]).
+    pub entry_shift_mm: [f32; 3],
 }
 
 impl AngularFactors {
@@ -155,6 +158,7 @@ impl AngularFactors {
             cos_t_min: 0.0,
             incidence: [[1.0; 3]; mc_profile::INCIDENCE_NODES],
             exit: [[[1.0; 3]; mc_profile::EXIT_BINS]; mc_profile::INCIDENCE_NODES],
+            entry_shift_mm: [0.0; 3],
         }
     }
 
@@ -164,19 +168,22 @@ impl AngularFactors {
             cos_t_min: profiles[0].cos_t_min as f32,
             incidence: std::array::from_fn(|k| [0, 1, 2].map(|c| profiles[c].incidence[k] as f32)),
             exit: std::array::from_fn(|k| std::array::from_fn(|b| [0, 1, 2].map(|c| profiles[c].exit[k][b] as f32))),
+            entry_shift_mm: [0, 1, 2].map(|c| profiles[c].entry_shift as f32),
         }
     }
 
     /// Texel TABLE_SIZE + k of the object's table buffer: the incidence factors at node k (and,
-    /// in w, cos θt of node 0), then the exit factors, node by node, bin by bin (f32 bits).
+    /// in w, cos θt of node 0), then the exit factors, node by node, bin by bin, then the entry
+    /// shift (f32 bits).
     pub fn texels(&self) -> Vec<[u32; 4]> {
         let incidence = self.incidence.iter().map(|f| [f[0], f[1], f[2], self.cos_t_min].map(f32::to_bits));
         let exit = self.exit.iter().flatten().map(|h| [h[0], h[1], h[2], 0.0].map(f32::to_bits));
-        incidence.chain(exit).collect()
+        let [r, g, b] = self.entry_shift_mm;
+        incidence.chain(exit).chain(std::iter::once([r, g, b, 0.0].map(f32::to_bits))).collect()
     }
 
     /// Texels after the Sd table.
-    pub const TEXELS: usize = mc_profile::INCIDENCE_NODES * (1 + mc_profile::EXIT_BINS);
+    pub const TEXELS: usize = mc_profile::INCIDENCE_NODES * (1 + mc_profile::EXIT_BINS) + 1;
 }
 
 const _: () = assert!(slab_profile::THICKNESS_NODES == super::SLAB_THICKNESS_NODES as usize);
@@ -259,6 +266,56 @@ impl SlabTransmission {
     pub const TEXELS: usize = 1
         + slab_profile::LOOKUP_NODES * slab_profile::ENTRIES
         + slab_profile::THICKNESS_NODES * slab_profile::EXIT_BINS;
+}
+
+const _: () = assert!(curvature_profile::CURVATURE_NODES == super::CURVATURE_NODES as usize);
+const _: () = assert!(curvature_profile::ENTRIES == super::CURVATURE_ENTRIES as usize);
+const _: () = assert!(curvature_profile::FIRST_CURVATURE_LOG2 + 8 == super::CURVATURE_FIRST_LOG2_PLUS_8 as i32);
+
+/// The Monte Carlo table's curvature ratios, after the light across in the same buffer
+/// (bssrdf.glsl's `curvature_rows`, `curvature_ratio`; [`CurvatureChannel`]): a header texel (L in
+/// mm; 0 for the other models, which never read the rest), then rows of ENTRIES texels, texel i
+/// holding entries i and i + 1 per channel as two f16: row 0 the flat surface (every entry 1),
+/// rows 1 … N the convex nodes, N + 1 … 2N the concave ones.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CurvatureRatios {
+    pub unit_mm: f32,
+    /// Per row, per entry, per channel.
+    pub rows: Vec<[[f32; 3]; curvature_profile::ENTRIES]>,
+}
+
+impl CurvatureRatios {
+    pub const ROWS: usize = 1 + 2 * curvature_profile::CURVATURE_NODES;
+
+    /// Every row flat (the models without it).
+    pub fn none() -> CurvatureRatios {
+        CurvatureRatios { unit_mm: 0.0, rows: vec![[[1.0; 3]; curvature_profile::ENTRIES]; Self::ROWS] }
+    }
+
+    pub fn monte_carlo(channels: &[std::sync::Arc<CurvatureChannel>; 3]) -> CurvatureRatios {
+        let row = |pick: &dyn Fn(&CurvatureChannel) -> [f64; curvature_profile::ENTRIES]| {
+            std::array::from_fn(|i| [0, 1, 2].map(|c| pick(&channels[c])[i] as f32))
+        };
+        let mut rows = vec![[[1.0; 3]; curvature_profile::ENTRIES]];
+        rows.extend((0..curvature_profile::CURVATURE_NODES).map(|k| row(&|c| c.convex[k])));
+        rows.extend((0..curvature_profile::CURVATURE_NODES).map(|k| row(&|c| c.concave[k])));
+        CurvatureRatios { unit_mm: channels[0].unit_mm as f32, rows }
+    }
+
+    pub fn texels(&self) -> Vec<[u32; 4]> {
+        let header = std::iter::once([self.unit_mm.to_bits(), 0, 0, 0]);
+        let pairs = self.rows.iter().flat_map(|row| {
+            (0..curvature_profile::ENTRIES).map(move |i| {
+                let next = row[(i + 1).min(curvature_profile::ENTRIES - 1)];
+                let pair = |c: usize| half_bits(row[i][c]) as u32 | (half_bits(next[c]) as u32) << 16;
+                [pair(0), pair(1), pair(2), 0]
+            })
+        });
+        header.chain(pairs).collect()
+    }
+
+    /// Texels after the light across.
+    pub const TEXELS: usize = 1 + Self::ROWS * curvature_profile::ENTRIES;
 }
 
 /// Beam diffusion's entry at `r` of a table of `reach`: Sd, but at r = 0 the v0 for which the

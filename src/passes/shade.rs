@@ -112,6 +112,8 @@ pub struct SurfaceDraw<'a> {
     pub index_count: u32,
     /// One uv per vertex.
     pub uvs: &'a Buffer,
+    /// One mean curvature per vertex (zeros but for the Monte Carlo table's objects).
+    pub curvature: &'a Buffer,
     /// Its texture's image and sampler (gpu_world::SurfaceTexture).
     pub texture: (&'a Image, &'a Sampler),
     pub constants: SurfaceConstants,
@@ -228,14 +230,18 @@ impl ShadePass {
         for o in draws {
             rec.use_buffer(o.vertices, vk::Access::VERTEX_INPUT)?;
             rec.use_buffer(o.indices, vk::Access::INDEX_INPUT)?;
-            rec.prepare_draw_reads(&[Bind::Read(o.uvs), Bind::Sampled(o.texture.0, o.texture.1)])?;
+            rec.prepare_draw_reads(&[
+                Bind::Read(o.uvs),
+                Bind::Sampled(o.texture.0, o.texture.1),
+                Bind::Read(o.curvature),
+            ])?;
         }
         let clear = Some([0.0; 4]);
         let gbuffer = [(targets.position, clear), (targets.normal, clear), (targets.albedo, clear)];
         rec.begin_rendering(&gbuffer, Some((targets.depth, Some(1.0))), 0)?;
         for o in draws {
             let (v, i) = (Some(o.vertices), Some(o.indices));
-            let binds = [Bind::Read(o.uvs), Bind::Sampled(o.texture.0, o.texture.1)];
+            let binds = [Bind::Read(o.uvs), Bind::Sampled(o.texture.0, o.texture.1), Bind::Read(o.curvature)];
             rec.draw(&self.surface, &binds, vk::bytes_of(&o.constants), v, i, o.index_count, 1)?;
         }
         rec.end_rendering();

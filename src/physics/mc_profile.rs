@@ -108,6 +108,16 @@ pub struct McProfile {
     /// h per incidence node and exit bin: the radiance leaving per unit exitance, over the
     /// renderer's lobe Ft(θo)/∫Ft cos θ dω (so that it integrates to 1 against that lobe).
     pub exit: [[f64; EXIT_BINS]; INCIDENCE_NODES],
+    /// Where light enters obliquely, what leaves (two or more scatterings) is centred not on the
+    /// entry point but ahead of it along the refracted beam's tangential direction: its mean
+    /// exit position, per incidence node (mm), and the least-squares slope δ (mm) of that
+    /// shift over sin θt, which the shade pass applies as xi + δ·(tangential part of the mean
+    /// refracted direction): linear in the lights, nothing on a flat surface lit evenly (a
+    /// translation), but on a sphere lit from the front every source's light leans away from
+    /// the pixel (the front-lit 10 mm spheres: −20 to −30% of what the curvature adds;
+    /// physics::curvature_profile).
+    pub shift: [f64; INCIDENCE_NODES],
+    pub entry_shift: f64,
 }
 
 /// The edges of radial bin `k` in mean free paths.
@@ -174,8 +184,10 @@ impl McProfile {
         // Per incidence node: photons traced, escapes per exit bin. The last node (normal
         // incidence) also gives the radial profile.
         let mut runs = [(0u64, [0u64; EXIT_BINS]); INCIDENCE_NODES];
+        // Per node: Σ x of the exits of two or more scatterings (mean free paths).
+        let mut exit_x = [0.0f64; INCIDENCE_NODES];
         let mut single = 0u64;
-        for (k, (traced, exit_counts)) in runs.iter_mut().enumerate() {
+        for (k, ((traced, exit_counts), sum_x)) in runs.iter_mut().zip(exit_x.iter_mut()).enumerate() {
             let cos_t = incidence_node(cos_t_min, k);
             let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
             let start = glam::DVec3::new(sin_t, 0.0, -cos_t);
@@ -208,6 +220,7 @@ impl McProfile {
                     |e| {
                         if e.scatterings >= 2 {
                             exit_counts[exit_bin(e)] += 1;
+                            *sum_x += e.x;
                         }
                     },
                 )
@@ -248,7 +261,21 @@ impl McProfile {
                 }
             })
         });
+        let shift: [f64; INCIDENCE_NODES] = std::array::from_fn(|k| {
+            let n = runs[k].1.iter().sum::<u64>();
+            if n > 0 && sigma_t_reduced > 0.0 {
+                exit_x[k] / n as f64 / sigma_t_reduced
+            } else {
+                0.0
+            }
+        });
+        let sin_t = |k: usize| (1.0 - incidence_node(cos_t_min, k).powi(2)).max(0.0).sqrt();
+        let (num, den) =
+            (0..INCIDENCE_NODES).fold((0.0, 0.0), |(a, b), k| (a + shift[k] * sin_t(k), b + sin_t(k).powi(2)));
+        let entry_shift = if den > 0.0 { num / den } else { 0.0 };
         let mut profile = McProfile {
+            shift,
+            entry_shift,
             sigma_t_reduced,
             albedo_reduced: albedo,
             eta,

@@ -6,6 +6,7 @@
 //! lengths in mm, normals outward, ωi from the surface toward the light, η = n_inside/n_outside.
 
 pub mod beam_diffusion;
+pub mod curvature_profile;
 pub mod dipole;
 pub mod dirpole;
 pub mod fresnel;

@@ -26,12 +26,17 @@ pub struct SphereEscape {
     pub scatterings: u32,
 }
 
-/// Distance along `d` from `p` (inside) to the sphere |p − c| = R, c = (0, 0, −R). Written with
-/// |q|² − R² = |p|² + 2Rz, which keeps its precision near the pole for large R, and the
-/// cancellation-free root.
+/// Distance along `d` from `p` (in the medium) to the sphere |p − c| = |R|, c = (0, 0, −R).
+/// Written with |q|² − R² = |p|² + 2Rz, which keeps its precision near the pole for large R, and
+/// the cancellation-free root. A negative `radius` is a cavity (the medium outside the ball,
+/// the surface concave): the ray meets it only going toward it within |R| (else ∞).
 fn distance_out(radius: f64, p: DVec3, d: DVec3) -> f64 {
     let b = p.dot(d) + radius * d.z;
     let c = p.length_squared() + 2.0 * radius * p.z;
+    if radius < 0.0 {
+        let disc = b * b - c;
+        return if b >= 0.0 || disc < 0.0 { f64::INFINITY } else { (c / (-b + disc.sqrt())).max(0.0) };
+    }
     let root = (b * b - c).max(0.0).sqrt();
     let t = if b > 0.0 { -c / (b + root) } else { root - b };
     t.max(0.0)
@@ -57,7 +62,8 @@ fn walk(
         let t = distance_out(radius, p, d);
         if s >= t {
             p += t * d;
-            let n = (p - centre).normalize();
+            // Outward from the medium: away from a ball's centre, toward a cavity's.
+            let n = ((p - centre) * radius.signum()).normalize();
             let cos = d.dot(n).clamp(0.0, 1.0);
             if rng.next() < fresnel::reflectance(1.0 / eta, cos) {
                 d = (d - 2.0 * d.dot(n) * n).normalize();
@@ -66,8 +72,9 @@ fn walk(
             let mu_o2 = (1.0 - eta * eta * (1.0 - cos * cos)).clamp(0.0, 1.0);
             // Snell from index η to 1: the tangential part scales by η.
             let direction = (eta * (d - cos * n) + mu_o2.sqrt() * n).normalize();
-            let q = p - centre;
-            let geodesic = radius * (q.x * q.x + q.y * q.y).sqrt().atan2(q.z);
+            // |R| times the angle at the centre between the pole and the exit.
+            let (q, pole) = (p - centre, -centre);
+            let geodesic = radius.abs() * q.cross(pole).length().atan2(q.dot(pole));
             on_escape(&SphereEscape { position: p, direction, mu_o2, geodesic, scatterings });
             return scatterings;
         }
@@ -86,7 +93,8 @@ fn walk(
 /// [`halfspace::trace_slab`]'s walk in a sphere of radius `radius` (mean free paths): `photons`
 /// photons start at the pole going `start` (into the medium, z < 0; [`halfspace::entry_direction`]
 /// gives the refracted beam of an angle of incidence), with reduced albedo `albedo` and index
-/// `eta`. Returns the scatterings traced.
+/// `eta`; a negative `radius` walks the medium outside a spherical cavity of radius |R| instead
+/// (a concave surface, centre (0, 0, |R|)). Returns the scatterings traced.
 pub fn trace_sphere(
     albedo: f64,
     eta: f64,
@@ -100,6 +108,18 @@ pub fn trace_sphere(
     (0..photons)
         .map(|_| walk(&mut rng, (albedo, eta, radius), DVec3::ZERO, start, max_collisions, &mut on_escape) as u64)
         .sum()
+}
+
+/// One photon's walk from `p` on the sphere going `d` into it (a beam entering anywhere, not
+/// only at the pole), seeded `seed`; returns its scatterings.
+pub fn trace_from(
+    (albedo, eta, radius): (f64, f64, f64),
+    p: DVec3,
+    d: DVec3,
+    (seed, max_collisions): (u64, u32),
+    mut on_escape: impl FnMut(&SphereEscape),
+) -> u32 {
+    walk(&mut Rng(seed), (albedo, eta, radius), p, d, max_collisions, &mut on_escape)
 }
 
 /// Rings of geodesic distance from the entry point (mean free paths): edge 0 is 0, then
