@@ -71,17 +71,20 @@ vec4 slab_header; // the Monte Carlo table's slab header (L in mm, scales), read
 // the longest diffusion length so that its sources' is nearly the same.
 vec4 pixel_curvature_rows;
 float pixel_curvature_mm = 0.0;
-// The Monte Carlo table's oblique-entry shift per channel (table_entry_shift), read once.
-vec3 entry_shift_mm = vec3(0.0);
 
-// The Monte Carlo table's multiple scattering at xo from a source at xi whose light entered
-// along mean refracted directions with tangential parts `along[c]` (per channel; length sin θt
-// for one light, shorter where lights differ): Sp at |xo − (xi + δ_c·along_c)| per channel,
-// times the curvature ratio at the chord |xo − xi|. `d` = xo − xi in mm.
-vec3 mc_sd(vec3 d, vec3 along[3]) {
-    vec3 r = vec3(length(d - entry_shift_mm.x * along[0]), length(d - entry_shift_mm.y * along[1]),
-                  length(d - entry_shift_mm.z * along[2]));
-    return sd_table_per_channel(dipole_table, dipole_header, r) * curvature_ratio(dipole_table, pixel_curvature_rows, length(d));
+// The Monte Carlo table's multiple scattering at xo from a source at (xi, ni) whose light entered
+// along mean refracted directions with parts `along[c]` along the surface (per channel; length
+// sin θt for one light, shorter where lights differ): Sp(r)·(1 + b(r) along·d̂) (the azimuthal
+// harmonic, d̂ the direction to xo along xi's surface) times the curvature ratio, r = |d|,
+// d = xo − xi in mm.
+vec3 mc_sd(vec3 d, vec3 ni, vec3 along[3]) {
+    float r = length(d);
+    vec3 tangential = d - dot(d, ni) * ni;
+    float len = length(tangential);
+    vec3 dir = len > 0.0 ? tangential / len : vec3(0.0);
+    vec3 lean = vec3(dot(along[0], dir), dot(along[1], dir), dot(along[2], dir));
+    vec3 azimuth = max(vec3(1.0) + table_azimuth(dipole_table, dipole_header, r) * lean, vec3(0.0));
+    return dipole_sd_table(dipole_table, dipole_header, r) * azimuth * curvature_ratio(dipole_table, pixel_curvature_rows, r);
 }
 
 const uint STACK_SIZE = 96u;
@@ -160,7 +163,7 @@ vec3 source(vec3 xi, vec3 ni, vec3 wi, vec3 power, vec3 xo, vec3 no) {
         // One light: its refracted direction's part along the surface, −(wi − (wi·ni)ni)/η.
         vec3 t = -(wi - dot(wi, ni) * ni) / object_params.channels[0].eta;
         vec3 along[3] = vec3[](t, t, t);
-        sd = across(xi, ni, xo, no, mc_sd((xo - xi) * s, along), power * (s * s));
+        sd = across(xi, ni, xo, no, mc_sd((xo - xi) * s, ni, along), power * (s * s));
     } else {
         sd = dipole_sd_table(dipole_table, dipole_header, length(xo - xi) * s);
     }
@@ -197,7 +200,7 @@ vec3 merged_source(vec3 xi, vec3 ni, vec3 power, vec4 incident[3], vec3 dw, vec3
             vec3 t = incident[c].xyz - dot(incident[c].xyz, ni) * ni;
             along[c] = power[c] > 0.0 ? -t * (inv_eta / power[c]) : vec3(0.0);
         }
-        sd = mc_sd((xo - xi) * s, along);
+        sd = mc_sd((xo - xi) * s, ni, along);
         if (across_object) sd = across(xi, ni, xo, no, sd, power * (s * s));
     } else {
         sd = dipole_sd_table(dipole_table, dipole_header, length(xo - xi) * s);
@@ -277,7 +280,7 @@ float near_correction(vec3 xi, vec3 ni, float area, vec3 xo, vec3 no, inout uint
 // The integral is a fixed quadrature over the disk (this function). Radially: Gauss–Legendre on
 // [0, start] in t, r = scale · sinh t (r dr = scale² sinh t cosh t dt: smooth where Sd peaks
 // over ~D, and where Sd ~ 1/r for beam diffusion's single scattering), and on [start, end],
-// where 1 − w falls smoothly to 0. Angularly (the directional dipole and the Monte Carlo table, whose sources shift; the other tables are
+// where 1 − w falls smoothly to 0. Angularly (the directional dipole and the Monte Carlo table, whose sources lean; the other tables are
 // radial): NEAR_ANGLES angles on the half circle from the lights' mean tangential direction,
 // each standing for its mirror image too (the source is symmetric about the plane of the normal
 // and the refracted light). The quadrature's error against a fine f64 grid: within 0.015%
@@ -319,7 +322,7 @@ vec3 near_field(vec3 xo, vec3 no, out uint made) {
         ? normalize(tangential)
         : normalize(cross(no, abs(no.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0)));
     vec3 t2 = cross(no, t1);
-    // The Monte Carlo table's sources are shifted along the light's direction: not radial either.
+    // The Monte Carlo table's sources lean along the light's direction: not radial either.
     uint angles = MODEL == MODEL_DIRECTIONAL || MODEL == MODEL_MC ? NEAR_ANGLES : 1u;
     float t_end = asinh(start / scale);
     vec3 sum = vec3(0.0);
@@ -609,7 +612,6 @@ void main() {
     own_weight = imageLoad(surface_albedo, pixel).rgb;
     dipole_header = dipole_table_header(dipole_table);
     slab_header = MODEL == MODEL_MC ? slab_header_of(dipole_table) : vec4(0.0);
-    if (MODEL == MODEL_MC) entry_shift_mm = table_entry_shift(dipole_table);
     if (MODEL == MODEL_MC) pixel_curvature_mm = normal_curvature.w / object_params.mm_per_unit;
     pixel_curvature_rows = MODEL == MODEL_MC ? curvature_rows(dipole_table, pixel_curvature_mm)
                                              : vec4(0.0, 0.0, 0.0, 1.0);

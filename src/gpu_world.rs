@@ -539,12 +539,9 @@ fn write_params(params: &mut Buffer, table: &mut Buffer, from: &MadeFrom, point_
                 let slabs = slabs.join().unwrap_or_else(|e| std::panic::resume_unwind(e));
                 (profiles, slabs, curved.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
             });
-            (
-                SdTable::monte_carlo(&profiles, &[0, 1, 2].map(constants)),
-                AngularFactors::monte_carlo(&profiles),
-                SlabTransmission::monte_carlo(&slabs),
-                CurvatureRatios::monte_carlo(&curved),
-            )
+            let sd_table = SdTable::monte_carlo(&profiles, &[0, 1, 2].map(constants));
+            let factors = AngularFactors::monte_carlo(&profiles, sd_table.reach);
+            (sd_table, factors, SlabTransmission::monte_carlo(&slabs), CurvatureRatios::monte_carlo(&curved))
         }
     };
     table.write(0, &sd_table.texels())?;

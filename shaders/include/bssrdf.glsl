@@ -102,22 +102,20 @@ vec3 table_exit_factor(usamplerBuffer table, float cos_t, float cos_o) {
     return h0 + (h1 - h0) * (x - i);
 }
 vec3 dipole_sd_table(usamplerBuffer table, vec4 header, float r) { return sd_table_at(table, 0, header, r); }
-// The table at a distance per channel (three lookups, each for its own channel): the Monte
-// Carlo table's sources shifted per channel (table_entry_shift).
-vec3 sd_table_per_channel(usamplerBuffer table, vec4 header, vec3 r) {
-    vec3 x = r / (r + header.w) * float(DIPOLE_TABLE_SIZE - 1u);
-    vec3 i = min(floor(x), vec3(float(DIPOLE_TABLE_SIZE - 2u)));
-    vec2 red = unpackHalf2x16(texelFetch(table, int(i.x) + 1).x);
-    vec2 green = unpackHalf2x16(texelFetch(table, int(i.y) + 1).y);
-    vec2 blue = unpackHalf2x16(texelFetch(table, int(i.z) + 1).z);
-    return header.xyz * mix(vec3(red.x, green.x, blue.x), vec3(red.y, green.y, blue.y), x - i);
+// The Monte Carlo table's azimuthal harmonic b(r) per channel (mirrors AngularFactors::azimuth,
+// physics::mc_profile::McProfile::azimuth): light entering along a refracted direction whose
+// part along the surface is m (|m| = sin θt) leaves at xo as M(r)·f(θt)·(1 + b(r) m·d̂), d̂ the
+// direction from xi to xo along the surface. After the exit factors, MC_AZIMUTH_ENTRIES texels,
+// texel i holding entries i and i + 1 per channel as two f16 at the centres of u = r/(r + reach)
+// (the Sd table's; 0 for the other models).
+const int AZIMUTH_BASE = int(DIPOLE_TABLE_SIZE + MC_INCIDENCE_NODES * (1u + MC_EXIT_BINS));
+vec3 table_azimuth(usamplerBuffer table, vec4 header, float r) {
+    float x = clamp(r / (r + header.w) * float(MC_AZIMUTH_ENTRIES) - 0.5, 0.0, float(MC_AZIMUTH_ENTRIES - 1u));
+    float i = min(floor(x), float(MC_AZIMUTH_ENTRIES - 2u));
+    uvec3 pairs = texelFetch(table, AZIMUTH_BASE + int(i)).xyz;
+    vec2 red = unpackHalf2x16(pairs.x), green = unpackHalf2x16(pairs.y), blue = unpackHalf2x16(pairs.z);
+    return mix(vec3(red.x, green.x, blue.x), vec3(red.y, green.y, blue.y), x - i);
 }
-// The Monte Carlo table's oblique-entry shift δ per channel (mm per unit sin θt; mirrors
-// AngularFactors::entry_shift_mm, physics::mc_profile::McProfile::entry_shift): multiple
-// scattering from light entering along a refracted direction ω12 leaves centred on
-// xi + δ·(ω12's part along the surface), the texel after the exit factors (0 for the others).
-const int ENTRY_SHIFT_TEXEL = int(DIPOLE_TABLE_SIZE + MC_INCIDENCE_NODES * (1u + MC_EXIT_BINS));
-vec3 table_entry_shift(usamplerBuffer table) { return uintBitsToFloat(texelFetch(table, ENTRY_SHIFT_TEXEL).xyz); }
 
 // The Monte Carlo table's light across an object (mirrors gpu::sd_table::SlabTransmission and
 // physics::slab_profile::SlabChannel::sd): the transmitted profile T(ρ; t) of a flat slab of
@@ -128,7 +126,7 @@ vec3 table_entry_shift(usamplerBuffer table) { return uintBitsToFloat(texelFetch
 // node (t_k = L·2^(k/2 − 4)) MC_EXIT_BINS exit factors h_T. Between nodes: the same u, linear in
 // log t; below node 0 held; faded to 0 over the last half octave. Two fetches and one log2 per
 // pair (on lavapipe every pair pays for it: both sides of a branch run).
-const int SLAB_BASE = ENTRY_SHIFT_TEXEL + 1;
+const int SLAB_BASE = AZIMUTH_BASE + int(MC_AZIMUTH_ENTRIES);
 const float SLAB_FIRST_LOG2 = float(SLAB_FIRST_NODE_LOG2_PLUS_8) - 8.0;
 vec4 slab_header_of(usamplerBuffer table) { return uintBitsToFloat(texelFetch(table, SLAB_BASE)); }
 float slab_node_thickness(float k) { return exp2(0.5 * k + SLAB_FIRST_LOG2); }

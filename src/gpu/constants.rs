@@ -16,6 +16,9 @@ pub const MODEL_MC: u32 = 3;
 /// (src/physics/mc_profile.rs's INCIDENCE_NODES and EXIT_BINS; checked equal in gpu::sd_table).
 pub const MC_INCIDENCE_NODES: u32 = 8;
 pub const MC_EXIT_BINS: u32 = 10;
+/// Entries of the Monte Carlo table's azimuthal harmonic (gpu::sd_table::AngularFactors), at
+/// the centres of u = r/(r + reach) of the Sd table's reach.
+pub const MC_AZIMUTH_ENTRIES: u32 = 64;
 /// The Monte Carlo table's light across an object (src/physics/slab_profile.rs's
 /// THICKNESS_NODES, LOOKUP_NODES, ENTRIES and FIRST_NODE_LOG2 + 8, checked equal in
 /// gpu::sd_table): measured and lookup thickness nodes, radial entries per node, and the first
@@ -63,6 +66,7 @@ pub const GLSL_CONSTANTS: &[(&str, u32)] = &[
     ("MODEL_MC", MODEL_MC),
     ("MC_INCIDENCE_NODES", MC_INCIDENCE_NODES),
     ("MC_EXIT_BINS", MC_EXIT_BINS),
+    ("MC_AZIMUTH_ENTRIES", MC_AZIMUTH_ENTRIES),
     ("SLAB_THICKNESS_NODES", SLAB_THICKNESS_NODES),
     ("SLAB_LOOKUP_NODES", SLAB_LOOKUP_NODES),
     ("SLAB_ENTRIES", SLAB_ENTRIES),

@@ -147,9 +147,13 @@ pub struct AngularFactors {
     pub incidence: [[f32; 3]; mc_profile::INCIDENCE_NODES],
     /// Per incidence node, per exit bin.
     pub exit: [[[f32; 3]; mc_profile::EXIT_BINS]; mc_profile::INCIDENCE_NODES],
-    /// The oblique entry's shift δ per channel (mm per unit sin θt; [`McProfile::entry_shift`]).
-    pub entry_shift_mm: [f32; 3],
+    /// The azimuthal harmonic b per channel ([`McProfile::azimuth`]) at the centres of
+    /// u = r/(r + reach) in [i, i + 1)/MC_AZIMUTH_ENTRIES, the Sd table's reach.
+    pub azimuth: [[f32; 3]; AZIMUTH_ENTRIES],
 }
+
+/// Entries of [`AngularFactors::azimuth`].
+pub const AZIMUTH_ENTRIES: usize = super::MC_AZIMUTH_ENTRIES as usize;
 
 impl AngularFactors {
     /// No factors: 1 at every node.
@@ -158,32 +162,40 @@ impl AngularFactors {
             cos_t_min: 0.0,
             incidence: [[1.0; 3]; mc_profile::INCIDENCE_NODES],
             exit: [[[1.0; 3]; mc_profile::EXIT_BINS]; mc_profile::INCIDENCE_NODES],
-            entry_shift_mm: [0.0; 3],
+            azimuth: [[0.0; 3]; AZIMUTH_ENTRIES],
         }
     }
 
-    /// The Monte Carlo table's (the channels share η, so cos θt of node 0 too).
-    pub fn monte_carlo(profiles: &[std::sync::Arc<McProfile>; 3]) -> AngularFactors {
+    /// The Monte Carlo table's (the channels share η, so cos θt of node 0 too), its azimuthal
+    /// harmonic on the map of the Sd table's `reach` (mm).
+    pub fn monte_carlo(profiles: &[std::sync::Arc<McProfile>; 3], reach: f64) -> AngularFactors {
         AngularFactors {
             cos_t_min: profiles[0].cos_t_min as f32,
             incidence: std::array::from_fn(|k| [0, 1, 2].map(|c| profiles[c].incidence[k] as f32)),
             exit: std::array::from_fn(|k| std::array::from_fn(|b| [0, 1, 2].map(|c| profiles[c].exit[k][b] as f32))),
-            entry_shift_mm: [0, 1, 2].map(|c| profiles[c].entry_shift as f32),
+            azimuth: std::array::from_fn(|i| {
+                let u = (i as f64 + 0.5) / AZIMUTH_ENTRIES as f64;
+                [0, 1, 2].map(|c| profiles[c].azimuth_factor(reach * u / (1.0 - u)) as f32)
+            }),
         }
     }
 
     /// Texel TABLE_SIZE + k of the object's table buffer: the incidence factors at node k (and,
-    /// in w, cos θt of node 0), then the exit factors, node by node, bin by bin, then the entry
-    /// shift (f32 bits).
+    /// in w, cos θt of node 0), then the exit factors, node by node, bin by bin (f32 bits), then
+    /// the azimuthal harmonic, texel i holding entries i and i + 1 per channel as two f16.
     pub fn texels(&self) -> Vec<[u32; 4]> {
         let incidence = self.incidence.iter().map(|f| [f[0], f[1], f[2], self.cos_t_min].map(f32::to_bits));
         let exit = self.exit.iter().flatten().map(|h| [h[0], h[1], h[2], 0.0].map(f32::to_bits));
-        let [r, g, b] = self.entry_shift_mm;
-        incidence.chain(exit).chain(std::iter::once([r, g, b, 0.0].map(f32::to_bits))).collect()
+        let azimuth = (0..AZIMUTH_ENTRIES).map(|i| {
+            let next = self.azimuth[(i + 1).min(AZIMUTH_ENTRIES - 1)];
+            let pair = |c: usize| half_bits(self.azimuth[i][c]) as u32 | (half_bits(next[c]) as u32) << 16;
+            [pair(0), pair(1), pair(2), 0]
+        });
+        incidence.chain(exit).chain(azimuth).collect()
     }
 
     /// Texels after the Sd table.
-    pub const TEXELS: usize = mc_profile::INCIDENCE_NODES * (1 + mc_profile::EXIT_BINS) + 1;
+    pub const TEXELS: usize = mc_profile::INCIDENCE_NODES * (1 + mc_profile::EXIT_BINS) + AZIMUTH_ENTRIES;
 }
 
 const _: () = assert!(slab_profile::THICKNESS_NODES == super::SLAB_THICKNESS_NODES as usize);

@@ -275,6 +275,19 @@ mod tests {
 #[cfg(test)]
 mod probe {
     use super::*;
+
+    /// m·d̂: the refracted direction's part along the surface `m` at xi (on a sphere about the
+    /// origin) against the direction to xo along it.
+    fn harmonic(xi: DVec3, xo: DVec3, m: DVec3) -> f64 {
+        let n = xi.normalize();
+        let d = xo - xi;
+        let t = d - d.dot(n) * n;
+        if t.length() > 0.0 {
+            m.dot(t.normalize())
+        } else {
+            0.0
+        }
+    }
     /// A front-lit sphere by the walk (directional light along −z onto a sphere of radius R mm):
     /// the exitance of orders ≥ 2 within 10° of the pole, against the renderer's superposition of
     /// normal-incidence profiles, flat (Sp) and curved (Sp·C).
@@ -505,8 +518,8 @@ mod probe {
                 let cos_t = (1.0 - (1.0 - cos_i * cos_i) / (m.eta * m.eta)).max(0.0).sqrt();
                 let sin_t = (1.0 - cos_t * cos_t).sqrt();
                 let xi = DVec3::new(theta.sin(), 0.0, theta.cos()) * r_mm;
-                let moved = xi + DVec3::new(theta.cos(), 0.0, -theta.sin()) * (profile.entry_shift * sin_t);
                 let xo = DVec3::new(0.0, 0.0, r_mm);
+                let lean = harmonic(xi, xo, DVec3::new(theta.cos(), 0.0, -theta.sin()) * sin_t);
                 let weight = cos_i
                     * crate::physics::fresnel::transmittance(m.eta, cos_i)
                     * profile.incidence_factor(cos_t)
@@ -516,10 +529,13 @@ mod probe {
                     * r_mm
                     * theta.sin()
                     * (PI / 2.0 / steps as f64);
-                model +=
-                    weight * profile.exitance((xo - moved).length()) * curv[c].ratio((xo - xi).length(), 1.0 / r_mm);
+                let r = (xo - xi).length();
+                model += weight
+                    * profile.exitance(r)
+                    * (1.0 + profile.azimuth_factor(r) * lean).max(0.0)
+                    * curv[c].ratio(r, 1.0 / r_mm);
             }
-            eprintln!("  model (shift {:.3} mm, table C): {:.3}", profile.entry_shift, model / truth);
+            eprintln!("  model (azimuthal harmonic, table C): {:.3}", model / truth);
             eprintln!("  shifted: sphere pencils {:.3}, flat {:.3}", shifted_sphere / truth, shifted_flat / truth);
             eprintln!("  superposed sphere pencils {superposed:.5} ({:.3})", superposed / truth);
             eprintln!(
@@ -610,9 +626,12 @@ mod probe {
                         let phi = (ip as f64 + 0.5) / np as f64 * 2.0 * PI;
                         let xi = DVec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos()) * r_mm;
                         let e_theta = DVec3::new(theta.cos() * phi.cos(), theta.cos() * phi.sin(), -theta.sin());
-                        let moved = xi + e_theta * (profile.entry_shift * sin_t);
-                        model +=
-                            w * profile.exitance((xo - moved).length()) * curv[c].ratio((xo - xi).length(), 1.0 / r_mm);
+                        let lean = harmonic(xi, xo, e_theta * sin_t);
+                        let r = (xo - xi).length();
+                        model += w
+                            * profile.exitance(r)
+                            * (1.0 + profile.azimuth_factor(r) * lean).max(0.0)
+                            * curv[c].ratio(r, 1.0 / r_mm);
                         flat += w * profile.exitance((xo - xi).length());
                     }
                 }
@@ -630,7 +649,7 @@ mod probe {
         let albedo = m.sigma_s / sigma_t;
         let radius = 5.0 * sigma_t;
         let edges = [0.0, 0.5, 1.0, 2.0, 3.0, 4.0, 6.0, 8.0, 10.0];
-        for deg in [0.0f64, 15.0, 30.0, 60.0] {
+        for deg in [0.0f64, 45.0, 75.0, 89.0] {
             let start = halfspace::entry_direction(m.eta, deg.to_radians().cos());
             let mut tallies = [[[0u64; 8]; 2]; 2]; // [sphere?][x<0?][bin]
             for photon in 0..200_000u64 {
@@ -658,7 +677,22 @@ mod probe {
                     .join(" ")
             };
             let flat = |side: usize| (0..8).map(|b| format!("{}", tallies[0][side][b])).collect::<Vec<_>>().join(" ");
-            eprintln!("{deg}°: behind (x<0) {} | ahead {} | flat counts behind {}", ratio(1), ratio(0), flat(1));
+            let all = (0..8)
+                .map(|b| {
+                    format!(
+                        "{:.2}",
+                        (tallies[1][0][b] + tallies[1][1][b]) as f64
+                            / (tallies[0][0][b] + tallies[0][1][b]).max(1) as f64
+                    )
+                })
+                .collect::<Vec<_>>()
+                .join(" ");
+            eprintln!(
+                "{deg}°: all {all} | behind (x<0) {} | ahead {} | flat counts behind {}",
+                ratio(1),
+                ratio(0),
+                flat(1)
+            );
         }
     }
 

@@ -108,16 +108,16 @@ pub struct McProfile {
     /// h per incidence node and exit bin: the radiance leaving per unit exitance, over the
     /// renderer's lobe Ft(θo)/∫Ft cos θ dω (so that it integrates to 1 against that lobe).
     pub exit: [[f64; EXIT_BINS]; INCIDENCE_NODES],
-    /// Where light enters obliquely, what leaves (two or more scatterings) is centred not on the
-    /// entry point but ahead of it along the refracted beam's tangential direction: its mean
-    /// exit position, per incidence node (mm), and the least-squares slope δ (mm) of that
-    /// shift over sin θt, which the shade pass applies as xi + δ·(tangential part of the mean
-    /// refracted direction): linear in the lights, nothing on a flat surface lit evenly (a
-    /// translation), but on a sphere lit from the front every source's light leans away from
-    /// the pixel (the front-lit 10 mm spheres: −20 to −30% of what the curvature adds;
-    /// physics::curvature_profile).
-    pub shift: [f64; INCIDENCE_NODES],
-    pub entry_shift: f64,
+    /// Where light enters obliquely, what leaves (two or more scatterings) leans ahead along the
+    /// refracted beam's tangential direction: at distance ρ and azimuth φ from that direction
+    /// the exitance is M(ρ)·f(θt)·(1 + b(ρ) sin θt cos φ), the first harmonic of the azimuthal
+    /// dependence measured at each oblique node (b = 2⟨cos φ⟩/sin θt, least squares over the
+    /// nodes: it is nearly proportional to sin θt), per radial bin of [`AZIMUTH_BINS`]. Linear
+    /// in the lights (the shade pass takes sin θt cos φ from the mean refracted direction's part
+    /// along the surface), nothing on a flat surface lit evenly (cos φ averages out), but on a
+    /// sphere lit from the front every source's light leans away from the pixel at the pole and
+    /// toward the rim (physics::curvature_profile).
+    pub azimuth: Vec<f64>,
 }
 
 /// The edges of radial bin `k` in mean free paths.
@@ -136,6 +136,67 @@ fn bin_of(rho: f64) -> Option<usize> {
     }
     let k = 1 + ((rho / RHO_MIN).ln() / (RHO_MAX / RHO_MIN).ln() * RADIAL_BINS as f64) as usize;
     (k <= RADIAL_BINS).then_some(k)
+}
+
+/// Radial bins of the azimuthal harmonic: AZIMUTH_PER_OCTAVE an octave of ρ from AZIMUTH_MIN
+/// mean free paths (bin 0 the disc below it).
+pub const AZIMUTH_BINS: usize = 60;
+const AZIMUTH_MIN: f64 = 0.01;
+const AZIMUTH_PER_OCTAVE: f64 = 4.0;
+/// Photons of the oblique nodes a bin's harmonic needs before it stands alone; fewer, and it is
+/// pooled with its neighbours (the far bins, where few photons go).
+const AZIMUTH_MIN_COUNT: u64 = 4000;
+
+fn azimuth_bin_of(rho: f64) -> Option<usize> {
+    if rho < AZIMUTH_MIN {
+        return Some(0);
+    }
+    let b = 1 + ((rho / AZIMUTH_MIN).log2() * AZIMUTH_PER_OCTAVE) as usize;
+    (b < AZIMUTH_BINS).then_some(b)
+}
+
+/// The centre of azimuth bin `b` in mean free paths (bin 0: half its edge).
+pub fn azimuth_bin_centre(b: usize) -> f64 {
+    if b == 0 {
+        return 0.5 * AZIMUTH_MIN;
+    }
+    AZIMUTH_MIN * 2f64.powf((b as f64 - 0.5) / AZIMUTH_PER_OCTAVE)
+}
+
+/// b per radial bin from the oblique nodes' Σ cos φ and counts: b = Σ_k 2Σcos φ_k s_k /
+/// Σ_k n_k s_k² (s_k = sin θt of node k), each bin pooled with its neighbours until
+/// AZIMUTH_MIN_COUNT photons count.
+fn azimuth_harmonic(
+    harmonic: &[[(f64, u64); AZIMUTH_BINS]; INCIDENCE_NODES],
+    sin_t: impl Fn(usize) -> f64,
+) -> Vec<f64> {
+    let sums: Vec<(f64, f64, u64)> = (0..AZIMUTH_BINS)
+        .map(|b| {
+            (0..INCIDENCE_NODES).fold((0.0, 0.0, 0), |(num, den, n), k| {
+                let (c, count) = harmonic[k][b];
+                (num + 2.0 * c * sin_t(k), den + count as f64 * sin_t(k).powi(2), n + count)
+            })
+        })
+        .collect();
+    (0..AZIMUTH_BINS)
+        .map(|b| {
+            let (mut num, mut den, mut n) = sums[b];
+            let mut w = 1;
+            while n < AZIMUTH_MIN_COUNT && w < AZIMUTH_BINS {
+                for j in [b.wrapping_sub(w), b + w] {
+                    if let Some(&(a, d, c)) = sums.get(j) {
+                        (num, den, n) = (num + a, den + d, n + c);
+                    }
+                }
+                w += 1;
+            }
+            if den > 0.0 {
+                (num / den).clamp(-1.0, 1.0)
+            } else {
+                0.0
+            }
+        })
+        .collect()
 }
 
 /// cos θt of incidence node `k`.
@@ -184,10 +245,10 @@ impl McProfile {
         // Per incidence node: photons traced, escapes per exit bin. The last node (normal
         // incidence) also gives the radial profile.
         let mut runs = [(0u64, [0u64; EXIT_BINS]); INCIDENCE_NODES];
-        // Per node: Σ x of the exits of two or more scatterings (mean free paths).
-        let mut exit_x = [0.0f64; INCIDENCE_NODES];
+        // Per node and azimuth bin: Σ cos φ and the count of the exits of two or more scatterings.
+        let mut harmonic = [[(0.0f64, 0u64); AZIMUTH_BINS]; INCIDENCE_NODES];
         let mut single = 0u64;
-        for (k, ((traced, exit_counts), sum_x)) in runs.iter_mut().zip(exit_x.iter_mut()).enumerate() {
+        for (k, ((traced, exit_counts), cos_phi)) in runs.iter_mut().zip(harmonic.iter_mut()).enumerate() {
             let cos_t = incidence_node(cos_t_min, k);
             let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
             let start = glam::DVec3::new(sin_t, 0.0, -cos_t);
@@ -220,7 +281,11 @@ impl McProfile {
                     |e| {
                         if e.scatterings >= 2 {
                             exit_counts[exit_bin(e)] += 1;
-                            *sum_x += e.x;
+                            let rho = (e.x * e.x + e.y * e.y).sqrt();
+                            if let Some(b) = azimuth_bin_of(rho) {
+                                cos_phi[b].0 += e.x / rho;
+                                cos_phi[b].1 += 1;
+                            }
                         }
                     },
                 )
@@ -261,21 +326,10 @@ impl McProfile {
                 }
             })
         });
-        let shift: [f64; INCIDENCE_NODES] = std::array::from_fn(|k| {
-            let n = runs[k].1.iter().sum::<u64>();
-            if n > 0 && sigma_t_reduced > 0.0 {
-                exit_x[k] / n as f64 / sigma_t_reduced
-            } else {
-                0.0
-            }
-        });
         let sin_t = |k: usize| (1.0 - incidence_node(cos_t_min, k).powi(2)).max(0.0).sqrt();
-        let (num, den) =
-            (0..INCIDENCE_NODES).fold((0.0, 0.0), |(a, b), k| (a + shift[k] * sin_t(k), b + sin_t(k).powi(2)));
-        let entry_shift = if den > 0.0 { num / den } else { 0.0 };
+        let azimuth = azimuth_harmonic(&harmonic, sin_t);
         let mut profile = McProfile {
-            shift,
-            entry_shift,
+            azimuth,
             sigma_t_reduced,
             albedo_reduced: albedo,
             eta,
@@ -346,6 +400,20 @@ impl McProfile {
     /// Sd(r) = M(r) / ∫Ft cos θ dω (1/mm²).
     pub fn sd(&self, r: f64) -> f64 {
         self.exitance(r) / self.exit_norm
+    }
+
+    /// The azimuthal harmonic b at distance `r` (mm): linear in log ρ between bin centres, held
+    /// beyond the outer ones.
+    pub fn azimuth_factor(&self, r: f64) -> f64 {
+        let rho = r * self.sigma_t_reduced;
+        let x = if rho <= azimuth_bin_centre(1) {
+            return self.azimuth[if rho < AZIMUTH_MIN { 0 } else { 1 }];
+        } else {
+            (rho / AZIMUTH_MIN).log2() * AZIMUTH_PER_OCTAVE + 0.5
+        };
+        let i = (x.floor() as usize).min(AZIMUTH_BINS - 2);
+        let f = (x - i as f64).clamp(0.0, 1.0);
+        self.azimuth[i] + (self.azimuth[i + 1] - self.azimuth[i]) * f
     }
 
     /// f at refracted cosine `cos_t`, linear between nodes.
