@@ -72,19 +72,21 @@ vec4 slab_header; // the Monte Carlo table's slab header (L in mm, scales), read
 vec4 pixel_curvature_rows;
 float pixel_curvature_mm = 0.0;
 
-// The Monte Carlo table's multiple scattering at xo from a source at (xi, ni) whose light entered
-// along mean refracted directions with parts `along[c]` along the surface (per channel; length
-// sin θt for one light, shorter where lights differ): Sp(r)·(1 + b(r) along·d̂) (the azimuthal
-// harmonic, d̂ the direction to xo along xi's surface) times the curvature ratio, r = |d|,
-// d = xo − xi in mm.
-vec3 mc_sd(vec3 d, vec3 ni, vec3 along[3]) {
+// The Monte Carlo table's multiple scattering at xo from a source at (xi, ni) lit from the mean
+// directions `toward[c]` (per channel, toward the lights, per unit power): Sp(r)·(1 + b(r) m·d̂),
+// the azimuthal harmonic of the light's lean, m = −(toward's part along the surface)/η the
+// refracted direction's part along it (|m| = sin θt for one light, shorter where lights
+// differ) and d̂ the direction to xo along xi's surface (so m·d̂ = −toward·d̂/η), times the
+// curvature ratio; r = |d|, d = xo − xi in mm.
+vec3 mc_sd(vec3 d, vec3 ni, vec3 toward[3]) {
     float r = length(d);
     vec3 tangential = d - dot(d, ni) * ni;
     float len = length(tangential);
-    vec3 dir = len > 0.0 ? tangential / len : vec3(0.0);
-    vec3 lean = vec3(dot(along[0], dir), dot(along[1], dir), dot(along[2], dir));
-    vec3 azimuth = max(vec3(1.0) + table_azimuth(dipole_table, dipole_header, r) * lean, vec3(0.0));
-    return dipole_sd_table(dipole_table, dipole_header, r) * azimuth * curvature_ratio(dipole_table, pixel_curvature_rows, r);
+    float scale = len > 0.0 ? -1.0 / (object_params.channels[0].eta * len) : 0.0;
+    vec3 lean = scale * vec3(dot(toward[0], tangential), dot(toward[1], tangential), dot(toward[2], tangential));
+    vec3 b;
+    vec3 sd = sd_table_azimuth(dipole_table, dipole_header, r, b);
+    return sd * max(vec3(1.0) + b * lean, vec3(0.0)) * curvature_ratio(dipole_table, pixel_curvature_rows, r);
 }
 
 const uint STACK_SIZE = 96u;
@@ -160,10 +162,8 @@ vec3 source(vec3 xi, vec3 ni, vec3 wi, vec3 power, vec3 xo, vec3 no) {
                   dirpole_channel_sd(object_params.channels[1], g, xi_mm, xo_mm, no),
                   dirpole_channel_sd(object_params.channels[2], g, xi_mm, xo_mm, no));
     } else if (MODEL == MODEL_MC) {
-        // One light: its refracted direction's part along the surface, −(wi − (wi·ni)ni)/η.
-        vec3 t = -(wi - dot(wi, ni) * ni) / object_params.channels[0].eta;
-        vec3 along[3] = vec3[](t, t, t);
-        sd = across(xi, ni, xo, no, mc_sd((xo - xi) * s, ni, along), power * (s * s));
+        vec3 toward[3] = vec3[](wi, wi, wi);
+        sd = across(xi, ni, xo, no, mc_sd((xo - xi) * s, ni, toward), power * (s * s));
     } else {
         sd = dipole_sd_table(dipole_table, dipole_header, length(xo - xi) * s);
     }
@@ -192,15 +192,10 @@ vec3 merged_source(vec3 xi, vec3 ni, vec3 power, vec4 incident[3], vec3 dw, vec3
         sd.y = dirpole_channel_sd(object_params.channels[1], with_refracted(g, w[1], no), xi_mm, xo_mm, no);
         sd.z = dirpole_channel_sd(object_params.channels[2], with_refracted(g, w[2], no), xi_mm, xo_mm, no);
     } else if (MODEL == MODEL_MC) {
-        // Each channel's mean refracted direction's part along the surface: −(Σωi's)/η per
-        // unit power (the merged record's, as the directional dipole's above).
-        float inv_eta = 1.0 / object_params.channels[0].eta;
-        vec3 along[3];
-        for (uint c = 0u; c < 3u; ++c) {
-            vec3 t = incident[c].xyz - dot(incident[c].xyz, ni) * ni;
-            along[c] = power[c] > 0.0 ? -t * (inv_eta / power[c]) : vec3(0.0);
-        }
-        sd = mc_sd((xo - xi) * s, ni, along);
+        // Each channel's mean direction toward its lights: Σ E ωi / Σ E (the merged record's).
+        vec3 toward[3];
+        for (uint c = 0u; c < 3u; ++c) toward[c] = power[c] > 0.0 ? incident[c].xyz / power[c] : vec3(0.0);
+        sd = mc_sd((xo - xi) * s, ni, toward);
         if (across_object) sd = across(xi, ni, xo, no, sd, power * (s * s));
     } else {
         sd = dipole_sd_table(dipole_table, dipole_header, length(xo - xi) * s);
@@ -280,7 +275,7 @@ float near_correction(vec3 xi, vec3 ni, float area, vec3 xo, vec3 no, inout uint
 // The integral is a fixed quadrature over the disk (this function). Radially: Gauss–Legendre on
 // [0, start] in t, r = scale · sinh t (r dr = scale² sinh t cosh t dt: smooth where Sd peaks
 // over ~D, and where Sd ~ 1/r for beam diffusion's single scattering), and on [start, end],
-// where 1 − w falls smoothly to 0. Angularly (the directional dipole and the Monte Carlo table, whose sources lean; the other tables are
+// where 1 − w falls smoothly to 0. Angularly (the directional dipole only; the tables are
 // radial): NEAR_ANGLES angles on the half circle from the lights' mean tangential direction,
 // each standing for its mirror image too (the source is symmetric about the plane of the normal
 // and the refracted light). The quadrature's error against a fine f64 grid: within 0.015%
@@ -322,8 +317,10 @@ vec3 near_field(vec3 xo, vec3 no, out uint made) {
         ? normalize(tangential)
         : normalize(cross(no, abs(no.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0)));
     vec3 t2 = cross(no, t1);
-    // The Monte Carlo table's sources lean along the light's direction: not radial either.
-    uint angles = MODEL == MODEL_DIRECTIONAL || MODEL == MODEL_MC ? NEAR_ANGLES : 1u;
+    // The tables are radial but for the Monte Carlo table's lean (1 + b cos φ), whose cos φ
+    // integrates to 0 over the circle: its one angle at φ = π/2 from the lights' direction
+    // (cos φ = 0) is exact.
+    uint angles = MODEL == MODEL_DIRECTIONAL ? NEAR_ANGLES : 1u;
     float t_end = asinh(start / scale);
     vec3 sum = vec3(0.0);
     for (uint j = 0u; j < 10u; ++j) {
@@ -614,7 +611,7 @@ void main() {
     slab_header = MODEL == MODEL_MC ? slab_header_of(dipole_table) : vec4(0.0);
     if (MODEL == MODEL_MC) pixel_curvature_mm = normal_curvature.w / object_params.mm_per_unit;
     pixel_curvature_rows = MODEL == MODEL_MC ? curvature_rows(dipole_table, pixel_curvature_mm)
-                                             : vec4(0.0, 0.0, 0.0, 1.0);
+                                             : vec4(-1.0, 0.0, 0.0, 1.0);
     vec3 wo = normalize(pc.eye.xyz - xo);
     vec3 sum = vec3(0.0);
     uint visits = 0u;

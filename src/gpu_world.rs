@@ -540,7 +540,7 @@ fn write_params(params: &mut Buffer, table: &mut Buffer, from: &MadeFrom, point_
                 (profiles, slabs, curved.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
             });
             let sd_table = SdTable::monte_carlo(&profiles, &[0, 1, 2].map(constants));
-            let factors = AngularFactors::monte_carlo(&profiles, sd_table.reach);
+            let factors = AngularFactors::monte_carlo(&profiles);
             (sd_table, factors, SlabTransmission::monte_carlo(&slabs), CurvatureRatios::monte_carlo(&curved))
         }
     };

@@ -102,31 +102,21 @@ vec3 table_exit_factor(usamplerBuffer table, float cos_t, float cos_o) {
     return h0 + (h1 - h0) * (x - i);
 }
 vec3 dipole_sd_table(usamplerBuffer table, vec4 header, float r) { return sd_table_at(table, 0, header, r); }
-// The Monte Carlo table's azimuthal harmonic b(r) per channel (mirrors AngularFactors::azimuth,
-// physics::mc_profile::McProfile::azimuth): light entering along a refracted direction whose
-// part along the surface is m (|m| = sin θt) leaves at xo as M(r)·f(θt)·(1 + b(r) m·d̂), d̂ the
-// direction from xi to xo along the surface. After the exit factors, MC_AZIMUTH_ENTRIES texels,
-// texel i holding entries i and i + 1 per channel as two f16 at the centres of u = r/(r + reach)
-// (the Sd table's; 0 for the other models).
-const int AZIMUTH_BASE = int(DIPOLE_TABLE_SIZE + MC_INCIDENCE_NODES * (1u + MC_EXIT_BINS));
-vec3 table_azimuth(usamplerBuffer table, vec4 header, float r) {
-    float x = clamp(r / (r + header.w) * float(MC_AZIMUTH_ENTRIES) - 0.5, 0.0, float(MC_AZIMUTH_ENTRIES - 1u));
-    float i = min(floor(x), float(MC_AZIMUTH_ENTRIES - 2u));
-    uvec3 pairs = texelFetch(table, AZIMUTH_BASE + int(i)).xyz;
+// The same, and from the same texel the Monte Carlo table's azimuthal harmonic b(r) per channel
+// (mirrors SdTable::azimuth_at, physics::mc_profile::McProfile::azimuth): light entering along a
+// refracted direction whose part along the surface is m (|m| = sin θt) leaves at xo as
+// M(r)·f(θt)·(1 + b(r) m·d̂), d̂ the direction from xi to xo along the surface; three 10-bit
+// signed fixed-point values in the texel's w (entry ⌊x⌋'s; 0 for the other tables).
+vec3 sd_table_azimuth(usamplerBuffer table, vec4 header, float r, out vec3 azimuth) {
+    float x = r / (r + header.w) * float(DIPOLE_TABLE_SIZE - 1u);
+    float i = min(floor(x), float(DIPOLE_TABLE_SIZE - 2u));
+    uvec4 pairs = texelFetch(table, int(i) + 1);
+    ivec3 b = ivec3(uvec3(pairs.w, pairs.w >> 10, pairs.w >> 20) & 0x3ffu);
+    azimuth = vec3(b - ivec3(greaterThanEqual(b, ivec3(512))) * 1024) / 511.0;
     vec2 red = unpackHalf2x16(pairs.x), green = unpackHalf2x16(pairs.y), blue = unpackHalf2x16(pairs.z);
-    return mix(vec3(red.x, green.x, blue.x), vec3(red.y, green.y, blue.y), x - i);
+    return header.xyz * mix(vec3(red.x, green.x, blue.x), vec3(red.y, green.y, blue.y), x - i);
 }
-
-// The Monte Carlo table's light across an object (mirrors gpu::sd_table::SlabTransmission and
-// physics::slab_profile::SlabChannel::sd): the transmitted profile T(ρ; t) of a flat slab of
-// thickness t as an Sd (1/mm²), ρ and t in mm. After the angular factors: texel SLAB_BASE
-// (`header`, read once per pixel) holds L (mm) and the channels' scales, then per lookup node j
-// (t_j = L·2^(j/4 − 4)) SLAB_ENTRIES texels, texel i holding entries i and i + 1 of T·reach_j²
-// per channel as two f16 at the centres of u = ρ/(ρ + reach), reach = t + L, then per measured
-// node (t_k = L·2^(k/2 − 4)) MC_EXIT_BINS exit factors h_T. Between nodes: the same u, linear in
-// log t; below node 0 held; faded to 0 over the last half octave. Two fetches and one log2 per
-// pair (on lavapipe every pair pays for it: both sides of a branch run).
-const int SLAB_BASE = AZIMUTH_BASE + int(MC_AZIMUTH_ENTRIES);
+const int SLAB_BASE = int(DIPOLE_TABLE_SIZE + MC_INCIDENCE_NODES * (1u + MC_EXIT_BINS));
 const float SLAB_FIRST_LOG2 = float(SLAB_FIRST_NODE_LOG2_PLUS_8) - 8.0;
 vec4 slab_header_of(usamplerBuffer table) { return uintBitsToFloat(texelFetch(table, SLAB_BASE)); }
 float slab_node_thickness(float k) { return exp2(0.5 * k + SLAB_FIRST_LOG2); }
@@ -168,38 +158,35 @@ vec3 slab_exit_factor(usamplerBuffer table, vec4 header, float t, float cos_o) {
     return h0 + (h1 - h0) * a;
 }
 
-// The Monte Carlo table's curvature ratios (mirrors gpu::sd_table::CurvatureRatios and
+// The Monte Carlo table's curvature ratios (mirrors gpu::sd_table::CurvatureRatios::lookup,
 // physics::curvature_profile::CurvatureChannel::ratio): C(r; κ), a sphere's (κ = 1/R > 0) or a
 // cavity's (κ < 0) multiple scattering over the half-space's at chord r, multiplying Sp(r).
-// After the light across: texel CURVATURE_BASE holds L (mm; 0: no ratios), then rows of
-// CURVATURE_ENTRIES texels (row 0 flat, 1 … N convex nodes κ_k L = 2^(k + first), N + 1 … 2N
-// concave), texel i holding entries i and i + 1 per channel as two f16 at the centres of
-// u = r/(r + L). `curvature_rows` (once per pixel): the two rows of κ (1/mm) and the second's
-// weight, linear in κ from the flat row to node 0 and in log κ between nodes, held past the
-// last; w = L. `curvature_ratio` (per pair): two fetches.
+// After the light across: texel CURVATURE_BASE holds L (mm; 0: no ratios), then per side (convex,
+// concave) CURVATURE_NODES rows of CURVATURE_TABLE_ENTRIES texels at the centres of
+// u = r/(r + L), row j's texel holding per channel the ratios of nodes j − 1 (−1: flat, 1) and j
+// (κ_j L = 2^(j + first)) as two f16. `curvature_rows` (once per pixel): the row of κ (1/mm) and
+// the weight of its upper node, linear in κ from flat to node 0 and in log κ between nodes, held
+// past the last; w = L. `curvature_ratio` (per pair): one fetch, the nearest entry.
 const int CURVATURE_BASE = SLAB_BASE + 1 + int(SLAB_LOOKUP_NODES * SLAB_ENTRIES + SLAB_THICKNESS_NODES * MC_EXIT_BINS);
 const float CURVATURE_FIRST_LOG2 = float(CURVATURE_FIRST_LOG2_PLUS_8) - 8.0;
 vec4 curvature_rows(usamplerBuffer table, float kappa) {
     float unit_mm = uintBitsToFloat(texelFetch(table, CURVATURE_BASE).x);
-    if (!(unit_mm > 0.0)) return vec4(0.0, 0.0, 0.0, 1.0);
+    if (!(unit_mm > 0.0)) return vec4(-1.0, 0.0, 0.0, 1.0);
     float x = abs(kappa) * unit_mm;
     if (!(x >= 0.0)) x = 0.0; // NaN: flat
     float side = kappa < 0.0 ? float(CURVATURE_NODES) : 0.0;
     float first = exp2(CURVATURE_FIRST_LOG2);
-    if (x < first) return vec4(0.0, 1.0 + side, x / first, unit_mm);
+    if (x < first) return vec4(side, x / first, 0.0, unit_mm);
     float k = min(log2(x) - CURVATURE_FIRST_LOG2, float(CURVATURE_NODES - 1u));
     float i = min(floor(k), float(CURVATURE_NODES - 2u));
-    return vec4(1.0 + side + i, 2.0 + side + i, k - i, unit_mm);
-}
-vec3 curvature_entry(usamplerBuffer table, float row, float i, float f) {
-    uvec3 pairs = texelFetch(table, CURVATURE_BASE + 1 + int(row) * int(CURVATURE_ENTRIES) + int(i)).xyz;
-    vec2 red = unpackHalf2x16(pairs.x), green = unpackHalf2x16(pairs.y), blue = unpackHalf2x16(pairs.z);
-    return mix(vec3(red.x, green.x, blue.x), vec3(red.y, green.y, blue.y), f);
+    return vec4(side + i + 1.0, k - i, 0.0, unit_mm);
 }
 vec3 curvature_ratio(usamplerBuffer table, vec4 rows, float r_mm) {
-    float x = clamp(r_mm / (r_mm + rows.w) * float(CURVATURE_ENTRIES) - 0.5, 0.0, float(CURVATURE_ENTRIES - 1u));
-    float i = min(floor(x), float(CURVATURE_ENTRIES - 2u));
-    return mix(curvature_entry(table, rows.x, i, x - i), curvature_entry(table, rows.y, i, x - i), rows.z);
+    if (rows.x < 0.0) return vec3(1.0);
+    int e = min(int(r_mm / (r_mm + rows.w) * float(CURVATURE_TABLE_ENTRIES)), int(CURVATURE_TABLE_ENTRIES) - 1);
+    uvec3 pairs = texelFetch(table, CURVATURE_BASE + 1 + int(rows.x) * int(CURVATURE_TABLE_ENTRIES) + e).xyz;
+    vec2 red = unpackHalf2x16(pairs.x), green = unpackHalf2x16(pairs.y), blue = unpackHalf2x16(pairs.z);
+    return mix(vec3(red.x, green.x, blue.x), vec3(red.y, green.y, blue.y), rows.y);
 }
 
 // The ray-source term S'(x, w, r) of the directional dipole.

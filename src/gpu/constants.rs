@@ -16,9 +16,6 @@ pub const MODEL_MC: u32 = 3;
 /// (src/physics/mc_profile.rs's INCIDENCE_NODES and EXIT_BINS; checked equal in gpu::sd_table).
 pub const MC_INCIDENCE_NODES: u32 = 8;
 pub const MC_EXIT_BINS: u32 = 10;
-/// Entries of the Monte Carlo table's azimuthal harmonic (gpu::sd_table::AngularFactors), at
-/// the centres of u = r/(r + reach) of the Sd table's reach.
-pub const MC_AZIMUTH_ENTRIES: u32 = 64;
 /// The Monte Carlo table's light across an object (src/physics/slab_profile.rs's
 /// THICKNESS_NODES, LOOKUP_NODES, ENTRIES and FIRST_NODE_LOG2 + 8, checked equal in
 /// gpu::sd_table): measured and lookup thickness nodes, radial entries per node, and the first
@@ -28,12 +25,13 @@ pub const SLAB_LOOKUP_NODES: u32 = 43;
 pub const SLAB_ENTRIES: u32 = 64;
 pub const SLAB_FIRST_NODE_LOG2_PLUS_8: u32 = 4;
 
-/// The Monte Carlo table's curvature ratios (src/physics/curvature_profile.rs's CURVATURE_NODES,
-/// ENTRIES and FIRST_CURVATURE_LOG2 + 8, checked equal in gpu::sd_table): nodes per sign of
-/// curvature, radial entries per node, node 0's log2 curvature plus 8 in units of 1/L.
+/// The Monte Carlo table's curvature ratios (src/physics/curvature_profile.rs's CURVATURE_NODES
+/// and FIRST_CURVATURE_LOG2 + 8, checked equal in gpu::sd_table): nodes per sign of curvature,
+/// node 0's log2 curvature plus 8 in units of 1/L; and the entries per row of the shade pass's
+/// table of them (gpu::sd_table::CurvatureRatios).
 pub const CURVATURE_NODES: u32 = 8;
-pub const CURVATURE_ENTRIES: u32 = 48;
 pub const CURVATURE_FIRST_LOG2_PLUS_8: u32 = 4;
+pub const CURVATURE_TABLE_ENTRIES: u32 = 192;
 
 /// Set in a tree node's child index when the child is a point (index into the sorted points).
 pub const LEAF_BIT: u32 = 0x8000_0000;
@@ -66,13 +64,12 @@ pub const GLSL_CONSTANTS: &[(&str, u32)] = &[
     ("MODEL_MC", MODEL_MC),
     ("MC_INCIDENCE_NODES", MC_INCIDENCE_NODES),
     ("MC_EXIT_BINS", MC_EXIT_BINS),
-    ("MC_AZIMUTH_ENTRIES", MC_AZIMUTH_ENTRIES),
     ("SLAB_THICKNESS_NODES", SLAB_THICKNESS_NODES),
     ("SLAB_LOOKUP_NODES", SLAB_LOOKUP_NODES),
     ("SLAB_ENTRIES", SLAB_ENTRIES),
     ("SLAB_FIRST_NODE_LOG2_PLUS_8", SLAB_FIRST_NODE_LOG2_PLUS_8),
     ("CURVATURE_NODES", CURVATURE_NODES),
-    ("CURVATURE_ENTRIES", CURVATURE_ENTRIES),
+    ("CURVATURE_TABLE_ENTRIES", CURVATURE_TABLE_ENTRIES),
     ("CURVATURE_FIRST_LOG2_PLUS_8", CURVATURE_FIRST_LOG2_PLUS_8),
     ("LEAF_BIT", LEAF_BIT),
     ("RADIX_TILE", RADIX_TILE),

@@ -28,6 +28,25 @@ pub struct SdTable {
     pub scale: [f32; 3],
     /// Sd / scale per channel at each entry, rounded to f16 (as the GPU reads it).
     pub values: Vec<[u16; 3]>,
+    /// The Monte Carlo table's azimuthal harmonic b per channel at each entry
+    /// ([`McProfile::azimuth`]), packed as three 10-bit signed fixed-point values
+    /// ([`pack_azimuth`]) in the texel's spare word; 0 for the other profiles.
+    pub azimuth: Vec<u32>,
+}
+
+/// Three values in [−1, 1] as 10-bit signed fixed point (steps of 1/511), bits 0–9, 10–19,
+/// 20–29 (bssrdf.glsl's `unpack_azimuth`).
+pub fn pack_azimuth(b: [f64; 3]) -> u32 {
+    let q = |x: f64| ((x.clamp(-1.0, 1.0) * 511.0).round() as i32 & 0x3ff) as u32;
+    q(b[0]) | q(b[1]) << 10 | q(b[2]) << 20
+}
+
+/// The values [`pack_azimuth`] packed.
+pub fn unpack_azimuth(w: u32) -> [f64; 3] {
+    [0, 10, 20].map(|shift| {
+        let v = ((w >> shift) & 0x3ff) as i32;
+        (if v >= 512 { v - 1024 } else { v }) as f64 / 511.0
+    })
 }
 
 impl SdTable {
@@ -52,7 +71,7 @@ impl SdTable {
             .iter()
             .map(|v| [0, 1, 2].map(|c| half_bits(if scale[c] > 0.0 { (v[c] / scale[c] as f64) as f32 } else { 0.0 })))
             .collect();
-        SdTable { reach, scale, values }
+        SdTable { reach, scale, values, azimuth: vec![0; TABLE_SIZE] }
     }
 
     /// The classical dipole's table.
@@ -92,9 +111,9 @@ impl SdTable {
             self.scale[2].to_bits(),
             (self.reach as f32).to_bits(),
         ]];
-        texels.extend(self.values.windows(2).map(|w| {
+        texels.extend(self.values.windows(2).zip(&self.azimuth).map(|(w, &b)| {
             let pair = |c: usize| w[0][c] as u32 | (w[1][c] as u32) << 16;
-            [pair(0), pair(1), pair(2), 0]
+            [pair(0), pair(1), pair(2), b]
         }));
         texels
     }
@@ -118,10 +137,26 @@ impl SdTable {
 impl SdTable {
     /// The half-space Monte Carlo's table (`--model mc`): its measured radial profile. The same
     /// reach as the classical dipole's.
+    /// Its texels carry the azimuthal harmonic, entry i's (nearest: the entries are 4096).
     pub fn monte_carlo(profiles: &[std::sync::Arc<McProfile>; 3], channels: &[ChannelConstants; 3]) -> SdTable {
         let sigma_tr =
             channels.iter().filter(|c| c.transports).map(|c| c.dipole_sigma_tr).fold(f64::INFINITY, f64::min);
-        SdTable::from_profile(reach_of(sigma_tr), |c, r| profiles[c].sd(r))
+        let mut table = SdTable::from_profile(reach_of(sigma_tr), |c, r| profiles[c].sd(r));
+        table.azimuth = (0..TABLE_SIZE)
+            .map(|i| {
+                let u = i as f64 / (TABLE_SIZE - 1) as f64;
+                let r = if i + 1 < TABLE_SIZE { table.reach * u / (1.0 - u) } else { f64::MAX };
+                pack_azimuth([0, 1, 2].map(|c| profiles[c].azimuth_factor(r)))
+            })
+            .collect();
+        table
+    }
+
+    /// The azimuthal harmonic per channel at distance `r` (mm), as the shade pass reads it
+    /// (`sd_table_azimuth`): entry ⌊x⌋'s.
+    pub fn azimuth_at(&self, r: f64) -> [f64; 3] {
+        let x = r / (r + self.reach) * (TABLE_SIZE - 1) as f64;
+        unpack_azimuth(self.azimuth[(x.floor() as usize).min(TABLE_SIZE - 2)])
     }
 
     /// The Monte Carlo table of one medium, in channel 0 (`bssrdf --gpu`'s, as
@@ -147,13 +182,7 @@ pub struct AngularFactors {
     pub incidence: [[f32; 3]; mc_profile::INCIDENCE_NODES],
     /// Per incidence node, per exit bin.
     pub exit: [[[f32; 3]; mc_profile::EXIT_BINS]; mc_profile::INCIDENCE_NODES],
-    /// The azimuthal harmonic b per channel ([`McProfile::azimuth`]) at the centres of
-    /// u = r/(r + reach) in [i, i + 1)/MC_AZIMUTH_ENTRIES, the Sd table's reach.
-    pub azimuth: [[f32; 3]; AZIMUTH_ENTRIES],
 }
-
-/// Entries of [`AngularFactors::azimuth`].
-pub const AZIMUTH_ENTRIES: usize = super::MC_AZIMUTH_ENTRIES as usize;
 
 impl AngularFactors {
     /// No factors: 1 at every node.
@@ -162,40 +191,28 @@ impl AngularFactors {
             cos_t_min: 0.0,
             incidence: [[1.0; 3]; mc_profile::INCIDENCE_NODES],
             exit: [[[1.0; 3]; mc_profile::EXIT_BINS]; mc_profile::INCIDENCE_NODES],
-            azimuth: [[0.0; 3]; AZIMUTH_ENTRIES],
         }
     }
 
-    /// The Monte Carlo table's (the channels share η, so cos θt of node 0 too), its azimuthal
-    /// harmonic on the map of the Sd table's `reach` (mm).
-    pub fn monte_carlo(profiles: &[std::sync::Arc<McProfile>; 3], reach: f64) -> AngularFactors {
+    /// The Monte Carlo table's (the channels share η, so cos θt of node 0 too).
+    pub fn monte_carlo(profiles: &[std::sync::Arc<McProfile>; 3]) -> AngularFactors {
         AngularFactors {
             cos_t_min: profiles[0].cos_t_min as f32,
             incidence: std::array::from_fn(|k| [0, 1, 2].map(|c| profiles[c].incidence[k] as f32)),
             exit: std::array::from_fn(|k| std::array::from_fn(|b| [0, 1, 2].map(|c| profiles[c].exit[k][b] as f32))),
-            azimuth: std::array::from_fn(|i| {
-                let u = (i as f64 + 0.5) / AZIMUTH_ENTRIES as f64;
-                [0, 1, 2].map(|c| profiles[c].azimuth_factor(reach * u / (1.0 - u)) as f32)
-            }),
         }
     }
 
     /// Texel TABLE_SIZE + k of the object's table buffer: the incidence factors at node k (and,
-    /// in w, cos θt of node 0), then the exit factors, node by node, bin by bin (f32 bits), then
-    /// the azimuthal harmonic, texel i holding entries i and i + 1 per channel as two f16.
+    /// in w, cos θt of node 0), then the exit factors, node by node, bin by bin (f32 bits).
     pub fn texels(&self) -> Vec<[u32; 4]> {
         let incidence = self.incidence.iter().map(|f| [f[0], f[1], f[2], self.cos_t_min].map(f32::to_bits));
         let exit = self.exit.iter().flatten().map(|h| [h[0], h[1], h[2], 0.0].map(f32::to_bits));
-        let azimuth = (0..AZIMUTH_ENTRIES).map(|i| {
-            let next = self.azimuth[(i + 1).min(AZIMUTH_ENTRIES - 1)];
-            let pair = |c: usize| half_bits(self.azimuth[i][c]) as u32 | (half_bits(next[c]) as u32) << 16;
-            [pair(0), pair(1), pair(2), 0]
-        });
-        incidence.chain(exit).chain(azimuth).collect()
+        incidence.chain(exit).collect()
     }
 
     /// Texels after the Sd table.
-    pub const TEXELS: usize = mc_profile::INCIDENCE_NODES * (1 + mc_profile::EXIT_BINS) + AZIMUTH_ENTRIES;
+    pub const TEXELS: usize = mc_profile::INCIDENCE_NODES * (1 + mc_profile::EXIT_BINS);
 }
 
 const _: () = assert!(slab_profile::THICKNESS_NODES == super::SLAB_THICKNESS_NODES as usize);
@@ -281,53 +298,107 @@ impl SlabTransmission {
 }
 
 const _: () = assert!(curvature_profile::CURVATURE_NODES == super::CURVATURE_NODES as usize);
-const _: () = assert!(curvature_profile::ENTRIES == super::CURVATURE_ENTRIES as usize);
 const _: () = assert!(curvature_profile::FIRST_CURVATURE_LOG2 + 8 == super::CURVATURE_FIRST_LOG2_PLUS_8 as i32);
 
+/// Entries per row of [`CurvatureRatios`] (bssrdf.glsl reads the nearest: fine enough that
+/// rounding r moves a ratio by under 1%).
+pub const CURVATURE_TABLE_ENTRIES: usize = super::CURVATURE_TABLE_ENTRIES as usize;
+
 /// The Monte Carlo table's curvature ratios, after the light across in the same buffer
-/// (bssrdf.glsl's `curvature_rows`, `curvature_ratio`; [`CurvatureChannel`]): a header texel (L in
-/// mm; 0 for the other models, which never read the rest), then rows of ENTRIES texels, texel i
-/// holding entries i and i + 1 per channel as two f16: row 0 the flat surface (every entry 1),
-/// rows 1 … N the convex nodes, N + 1 … 2N the concave ones.
+/// (bssrdf.glsl's `curvature_rows`, `curvature_ratio`; [`CurvatureChannel`], resampled at
+/// CURVATURE_TABLE_ENTRIES centres of u = r/(r + L)): a header texel (L in mm; 0 for the other
+/// models, which never read the rest), then 2N rows of entries, each texel holding per channel
+/// two neighbouring curvature nodes' ratios as two f16, so that one fetch interpolates in κ: on
+/// each side (convex, then concave) row j holds nodes j − 1 and j, node −1 being the flat
+/// surface (every ratio 1).
 #[derive(Clone, Debug, PartialEq)]
 pub struct CurvatureRatios {
     pub unit_mm: f32,
-    /// Per row, per entry, per channel.
-    pub rows: Vec<[[f32; 3]; curvature_profile::ENTRIES]>,
+    /// Per side, per node, per entry, per channel.
+    pub convex: Vec<Vec<[f32; 3]>>,
+    pub concave: Vec<Vec<[f32; 3]>>,
 }
 
 impl CurvatureRatios {
-    pub const ROWS: usize = 1 + 2 * curvature_profile::CURVATURE_NODES;
+    pub const ROWS: usize = 2 * curvature_profile::CURVATURE_NODES;
 
-    /// Every row flat (the models without it).
+    /// No ratios (the models without them): L = 0, every node flat.
     pub fn none() -> CurvatureRatios {
-        CurvatureRatios { unit_mm: 0.0, rows: vec![[[1.0; 3]; curvature_profile::ENTRIES]; Self::ROWS] }
+        let flat = vec![vec![[1.0; 3]; CURVATURE_TABLE_ENTRIES]; curvature_profile::CURVATURE_NODES];
+        CurvatureRatios { unit_mm: 0.0, convex: flat.clone(), concave: flat }
     }
 
     pub fn monte_carlo(channels: &[std::sync::Arc<CurvatureChannel>; 3]) -> CurvatureRatios {
-        let row = |pick: &dyn Fn(&CurvatureChannel) -> [f64; curvature_profile::ENTRIES]| {
-            std::array::from_fn(|i| [0, 1, 2].map(|c| pick(&channels[c])[i] as f32))
+        let unit = channels[0].unit_mm;
+        let nodes = |sign: f64| -> Vec<Vec<[f32; 3]>> {
+            (0..curvature_profile::CURVATURE_NODES)
+                .map(|k| {
+                    let kappa = sign * curvature_profile::node_curvature(k) / unit;
+                    (0..CURVATURE_TABLE_ENTRIES)
+                        .map(|i| {
+                            let u = (i as f64 + 0.5) / CURVATURE_TABLE_ENTRIES as f64;
+                            [0, 1, 2].map(|c| channels[c].ratio(unit * u / (1.0 - u), kappa) as f32)
+                        })
+                        .collect()
+                })
+                .collect()
         };
-        let mut rows = vec![[[1.0; 3]; curvature_profile::ENTRIES]];
-        rows.extend((0..curvature_profile::CURVATURE_NODES).map(|k| row(&|c| c.convex[k])));
-        rows.extend((0..curvature_profile::CURVATURE_NODES).map(|k| row(&|c| c.concave[k])));
-        CurvatureRatios { unit_mm: channels[0].unit_mm as f32, rows }
+        if !(unit > 0.0) {
+            return CurvatureRatios::none();
+        }
+        CurvatureRatios { unit_mm: unit as f32, convex: nodes(1.0), concave: nodes(-1.0) }
     }
 
     pub fn texels(&self) -> Vec<[u32; 4]> {
         let header = std::iter::once([self.unit_mm.to_bits(), 0, 0, 0]);
-        let pairs = self.rows.iter().flat_map(|row| {
-            (0..curvature_profile::ENTRIES).map(move |i| {
-                let next = row[(i + 1).min(curvature_profile::ENTRIES - 1)];
-                let pair = |c: usize| half_bits(row[i][c]) as u32 | (half_bits(next[c]) as u32) << 16;
-                [pair(0), pair(1), pair(2), 0]
-            })
-        });
-        header.chain(pairs).collect()
+        let flat = vec![[1.0f32; 3]; CURVATURE_TABLE_ENTRIES];
+        let side = |nodes: &Vec<Vec<[f32; 3]>>| -> Vec<[u32; 4]> {
+            (0..curvature_profile::CURVATURE_NODES)
+                .flat_map(|j| {
+                    let lower = if j == 0 { &flat } else { &nodes[j - 1] };
+                    let upper = &nodes[j];
+                    (0..CURVATURE_TABLE_ENTRIES)
+                        .map(|i| {
+                            let pair = |c: usize| half_bits(lower[i][c]) as u32 | (half_bits(upper[i][c]) as u32) << 16;
+                            [pair(0), pair(1), pair(2), 0]
+                        })
+                        .collect::<Vec<_>>()
+                })
+                .collect()
+        };
+        header.chain(side(&self.convex)).chain(side(&self.concave)).collect()
+    }
+
+    /// The ratio per channel at chord `r_mm` and curvature `kappa` (1/mm), as the shade pass
+    /// reads it: the nearest entry, linear in κ from the flat surface to node 0 and in log κ
+    /// between nodes, held past the last.
+    pub fn lookup(&self, r_mm: f64, kappa: f64) -> [f64; 3] {
+        let unit = self.unit_mm as f64;
+        if !(unit > 0.0) {
+            return [1.0; 3];
+        }
+        let nodes = if kappa < 0.0 { &self.concave } else { &self.convex };
+        let x = kappa.abs() * unit;
+        let first = curvature_profile::node_curvature(0);
+        let (lower, upper, f) = if x < first {
+            (None, 0, x / first)
+        } else {
+            let k = (x.log2() - curvature_profile::FIRST_CURVATURE_LOG2 as f64)
+                .min((curvature_profile::CURVATURE_NODES - 1) as f64);
+            let i = (k.floor() as usize).min(curvature_profile::CURVATURE_NODES - 2);
+            (Some(i), i + 1, k - i as f64)
+        };
+        let e = ((r_mm / (r_mm + unit) * CURVATURE_TABLE_ENTRIES as f64) as usize).min(CURVATURE_TABLE_ENTRIES - 1);
+        let value = |v: f32| half_value(half_bits(v));
+        [0, 1, 2].map(|c| {
+            let a = lower.map_or(1.0, |k| value(nodes[k][e][c]));
+            let b = value(nodes[upper][e][c]);
+            a + (b - a) * f
+        })
     }
 
     /// Texels after the light across.
-    pub const TEXELS: usize = 1 + Self::ROWS * curvature_profile::ENTRIES;
+    pub const TEXELS: usize = 1 + Self::ROWS * CURVATURE_TABLE_ENTRIES;
 }
 
 /// Beam diffusion's entry at `r` of a table of `reach`: Sd, but at r = 0 the v0 for which the

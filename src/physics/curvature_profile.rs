@@ -566,6 +566,8 @@ mod probe {
             let centre = DVec3::new(0.0, 0.0, -radius);
             let photons = 1_000_000u64;
             let mut counts = [0u64; 5];
+            let mut toward = [0u64; 5];
+            let cone = 12f64.to_radians();
             let mut rng = halfspace::SplitMix(777 + c as u64);
             let caps: Vec<DVec3> =
                 alphas.iter().map(|a| DVec3::new(a.to_radians().sin(), 0.0, a.to_radians().cos())).collect();
@@ -595,6 +597,9 @@ mod probe {
                             for (k, cp) in caps.iter().enumerate() {
                                 if q.dot(*cp) > cap.cos() {
                                     counts[k] += 1;
+                                    if e.direction.z > cone.cos() {
+                                        toward[k] += 1;
+                                    }
                                 }
                             }
                         }
@@ -635,7 +640,21 @@ mod probe {
                         flat += w * profile.exitance((xo - xi).length());
                     }
                 }
-                line += &format!(" α {a}: model {:.3} flat {:.3} ({} ph)", model / truth, flat / truth, counts[k]);
+                // Radiance toward +z (the camera along the light): the walk's, and the model's
+                // exitance times the half-space's exit distribution at the pixel's own incidence.
+                let cos_o = a.to_radians().cos();
+                let cos_t_own = (1.0 - (1.0 - cos_o * cos_o) / (m.eta * m.eta)).max(0.0).sqrt();
+                let lobe = crate::physics::fresnel::transmittance(m.eta, cos_o) * profile.exit_factor(cos_t_own, cos_o)
+                    / profile.exit_norm;
+                let radiance =
+                    toward[k] as f64 * (PI * r_mm * r_mm / photons as f64) / (cap_area * PI * cone.sin().powi(2));
+                line += &format!(
+                    " α {a}: model {:.3} flat {:.3} radiance {:.3} ({} ph)",
+                    model / truth,
+                    flat / truth,
+                    model * lobe / radiance,
+                    toward[k]
+                );
             }
             eprintln!("channel {c}:{line}");
         }
