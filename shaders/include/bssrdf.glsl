@@ -106,13 +106,13 @@ vec3 dipole_sd_table(usamplerBuffer table, vec4 header, float r) { return sd_tab
 // (mirrors SdTable::azimuth_at, physics::mc_profile::McProfile::azimuth): light entering along a
 // refracted direction whose part along the surface is m (|m| = sin θt) leaves at xo as
 // M(r)·f(θt)·(1 + b(r) m·d̂), d̂ the direction from xi to xo along the surface; three 10-bit
-// signed fixed-point values in the texel's w (entry ⌊x⌋'s; 0 for the other tables).
+// signed fixed-point values in [−2, 2] in the texel's w (entry ⌊x⌋'s; 0 for the other tables).
 vec3 sd_table_azimuth(usamplerBuffer table, vec4 header, float r, out vec3 azimuth) {
     float x = r / (r + header.w) * float(DIPOLE_TABLE_SIZE - 1u);
     float i = min(floor(x), float(DIPOLE_TABLE_SIZE - 2u));
     uvec4 pairs = texelFetch(table, int(i) + 1);
     ivec3 b = ivec3(uvec3(pairs.w, pairs.w >> 10, pairs.w >> 20) & 0x3ffu);
-    azimuth = vec3(b - ivec3(greaterThanEqual(b, ivec3(512))) * 1024) / 511.0;
+    azimuth = vec3(b - ivec3(greaterThanEqual(b, ivec3(512))) * 1024) / 255.5;
     vec2 red = unpackHalf2x16(pairs.x), green = unpackHalf2x16(pairs.y), blue = unpackHalf2x16(pairs.z);
     return header.xyz * mix(vec3(red.x, green.x, blue.x), vec3(red.y, green.y, blue.y), x - i);
 }

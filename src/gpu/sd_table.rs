@@ -34,10 +34,10 @@ pub struct SdTable {
     pub azimuth: Vec<u32>,
 }
 
-/// Three values in [−1, 1] as 10-bit signed fixed point (steps of 1/511), bits 0–9, 10–19,
-/// 20–29 (bssrdf.glsl's `unpack_azimuth`).
+/// Three values in [−2, 2] (b sin θt is a first harmonic: at most 2) as 10-bit signed fixed
+/// point (steps of 2/511), bits 0–9, 10–19, 20–29 (bssrdf.glsl's `sd_table_azimuth`).
 pub fn pack_azimuth(b: [f64; 3]) -> u32 {
-    let q = |x: f64| ((x.clamp(-1.0, 1.0) * 511.0).round() as i32 & 0x3ff) as u32;
+    let q = |x: f64| ((x.clamp(-2.0, 2.0) * 255.5).round() as i32 & 0x3ff) as u32;
     q(b[0]) | q(b[1]) << 10 | q(b[2]) << 20
 }
 
@@ -45,7 +45,7 @@ pub fn pack_azimuth(b: [f64; 3]) -> u32 {
 pub fn unpack_azimuth(w: u32) -> [f64; 3] {
     [0, 10, 20].map(|shift| {
         let v = ((w >> shift) & 0x3ff) as i32;
-        (if v >= 512 { v - 1024 } else { v }) as f64 / 511.0
+        (if v >= 512 { v - 1024 } else { v }) as f64 / 255.5
     })
 }
 
@@ -301,7 +301,7 @@ const _: () = assert!(curvature_profile::CURVATURE_NODES == super::CURVATURE_NOD
 const _: () = assert!(curvature_profile::FIRST_CURVATURE_LOG2 + 8 == super::CURVATURE_FIRST_LOG2_PLUS_8 as i32);
 
 /// Entries per row of [`CurvatureRatios`] (bssrdf.glsl reads the nearest: fine enough that
-/// rounding r moves a ratio by under 1%).
+/// rounding r moves a ratio by under 1%; tests/curvature_profile.rs).
 pub const CURVATURE_TABLE_ENTRIES: usize = super::CURVATURE_TABLE_ENTRIES as usize;
 
 /// The Monte Carlo table's curvature ratios, after the light across in the same buffer

@@ -191,7 +191,8 @@ fn azimuth_harmonic(
                 w += 1;
             }
             if den > 0.0 {
-                (num / den).clamp(-1.0, 1.0)
+                // A first harmonic of a non-negative function: |b| sin θt ≤ 2.
+                (num / den).clamp(-2.0, 2.0)
             } else {
                 0.0
             }
