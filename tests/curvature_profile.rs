@@ -131,7 +131,8 @@ fn the_front_lit_sphere_at_its_pole_matches_the_walk() {
         let mut count = 0u64;
         for i in 0..photons {
             let (rho, phi) = (radius * rng.next().sqrt(), 2.0 * PI * rng.next());
-            let p = DVec3::new(rho * phi.cos(), rho * phi.sin(), -radius + (radius * radius - rho * rho).max(0.0).sqrt());
+            let p =
+                DVec3::new(rho * phi.cos(), rho * phi.sin(), -radius + (radius * radius - rho * rho).max(0.0).sqrt());
             let n = (p - centre) / radius;
             let cos_i = n.z.clamp(0.0, 1.0);
             if rng.next() < fresnel::reflectance(m.eta, cos_i) {
@@ -159,8 +160,15 @@ fn the_front_lit_sphere_at_its_pole_matches_the_walk() {
             let cos_t = (1.0 - (1.0 - cos_i * cos_i) / (m.eta * m.eta)).max(0.0).sqrt();
             let sin_t = (1.0 - cos_t * cos_t).sqrt();
             let chord = 2.0 * r_mm * (theta / 2.0).sin();
-            let weight = cos_i * fresnel::transmittance(m.eta, cos_i) * profile.incidence_factor(cos_t)
-                * 2.0 * PI * r_mm * r_mm * theta.sin() * (PI / 2.0 / steps as f64);
+            let weight = cos_i
+                * fresnel::transmittance(m.eta, cos_i)
+                * profile.incidence_factor(cos_t)
+                * 2.0
+                * PI
+                * r_mm
+                * r_mm
+                * theta.sin()
+                * (PI / 2.0 / steps as f64);
             flat += weight * profile.exitance(chord);
             let lean = (1.0 - profile.azimuth_factor(chord) * sin_t).max(0.0);
             curved += weight * profile.exitance(chord) * lean * curvature[c].ratio(chord, 1.0 / r_mm);
