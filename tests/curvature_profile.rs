@@ -21,19 +21,6 @@ fn skin1() -> [Medium; 3] {
     [0, 1, 2].map(|c| m.channel(c))
 }
 
-/// A small SplitMix64 for the beam's entry points (the walks seed their own).
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        ((z >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-    }
-}
-
 #[test]
 fn a_ball_returns_more_a_cavity_less_and_flat_is_one() {
     let media = skin1();
@@ -126,28 +113,31 @@ fn the_front_lit_sphere_at_its_pole_matches_the_walk() {
         let sigma_t = m.sigma_a + m.sigma_s * (1.0 - m.g);
         let (albedo, radius) = (m.sigma_s * (1.0 - m.g) / sigma_t, r_mm * sigma_t);
         let centre = DVec3::new(0.0, 0.0, -radius);
-        let photons = 600_000u64;
-        let mut rng = Rng(12345 + c as u64);
-        let mut count = 0u64;
+        // Photons on a stratified grid over the sphere's disc (equal areas: ring k's radius
+        // ∝ √((k + ½)/rings)), each weighted by its Fresnel transmittance.
+        let (rings, angles) = (600u64, 1000u64);
+        let photons = rings * angles;
+        let (mut count, mut weighted) = (0u64, 0.0f64);
         for i in 0..photons {
-            let (rho, phi) = (radius * rng.next().sqrt(), 2.0 * PI * rng.next());
+            let (k, j) = (i / angles, i % angles);
+            let rho = radius * ((k as f64 + 0.5) / rings as f64).sqrt();
+            let phi = 2.0 * PI * (j as f64 + 0.5 * (k % 2) as f64) / angles as f64;
             let p =
                 DVec3::new(rho * phi.cos(), rho * phi.sin(), -radius + (radius * radius - rho * rho).max(0.0).sqrt());
             let n = (p - centre) / radius;
             let cos_i = n.z.clamp(0.0, 1.0);
-            if rng.next() < fresnel::reflectance(m.eta, cos_i) {
-                continue;
-            }
+            let ft = fresnel::transmittance(m.eta, cos_i);
             let cos_t = (1.0 - (1.0 - cos_i * cos_i) / (m.eta * m.eta)).max(0.0).sqrt();
             let t = ((DVec3::new(0.0, 0.0, -1.0) + cos_i * n) / m.eta - cos_t * n).normalize();
             let seed = 0x1234_5678 ^ i.wrapping_mul(0x9E37_79B9_7F4A_7C15);
             sphere::trace_from((albedo, m.eta, radius), p, t, (seed, 100_000), |e| {
                 if e.scatterings >= 2 && e.geodesic / radius < cap {
                     count += 1;
+                    weighted += ft;
                 }
             });
         }
-        let truth = count as f64 * (PI * r_mm * r_mm / photons as f64) / cap_area;
+        let truth = weighted * (PI * r_mm * r_mm / photons as f64) / cap_area;
         let noise = 1.0 / (count as f64).sqrt();
         // The renderer at the pole: Σ over the lit hemisphere of E cos θ Ft f(θt) Sp(r)
         // (1 + b(r) sin θt cos φ) C(r; 1/R); cos φ = −1 (every source leans away from the pole).

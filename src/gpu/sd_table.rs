@@ -343,7 +343,7 @@ impl CurvatureRatios {
                 })
                 .collect()
         };
-        if !(unit > 0.0) {
+        if unit.is_nan() || unit <= 0.0 {
             return CurvatureRatios::none();
         }
         CurvatureRatios { unit_mm: unit as f32, convex: nodes(1.0), concave: nodes(-1.0) }
@@ -374,7 +374,7 @@ impl CurvatureRatios {
     /// between nodes, held past the last.
     pub fn lookup(&self, r_mm: f64, kappa: f64) -> [f64; 3] {
         let unit = self.unit_mm as f64;
-        if !(unit > 0.0) {
+        if unit.is_nan() || unit <= 0.0 {
             return [1.0; 3];
         }
         let nodes = if kappa < 0.0 { &self.concave } else { &self.convex };

@@ -20,7 +20,7 @@ pub fn mean_curvature(mesh: &Mesh) -> Vec<f32> {
             let (a, b) = (a as usize, b as usize);
             let d = (mesh.positions[a] - mesh.positions[b]).as_dvec3();
             let len2 = d.length_squared();
-            if !(len2 > 0.0) {
+            if len2.is_nan() || len2 <= 0.0 {
                 continue;
             }
             let k = (mesh.normals[a] - mesh.normals[b]).as_dvec3().dot(d) / len2;
@@ -47,7 +47,7 @@ pub fn mean_curvature(mesh: &Mesh) -> Vec<f32> {
 /// the raw curvature.
 pub fn smoothed_mean_curvature(mesh: &Mesh, radius: f32) -> Vec<f32> {
     let raw = mean_curvature(mesh);
-    if !(radius > 0.0) || !radius.is_finite() {
+    if radius.is_nan() || radius <= 0.0 || !radius.is_finite() {
         return raw;
     }
     // Each vertex's area: a third of its triangles'.
@@ -57,7 +57,7 @@ pub fn smoothed_mean_curvature(mesh: &Mesh, radius: f32) -> Vec<f32> {
             area[v as usize] += a as f64 / 3.0;
         }
     }
-    let cell_of = |p: Vec3| IVec3::from((p / radius).floor().as_ivec3());
+    let cell_of = |p: Vec3| (p / radius).floor().as_ivec3();
     let side_of = |n: Vec3| {
         let a = n.abs();
         let axis = if a.x >= a.y && a.x >= a.z {

@@ -153,7 +153,9 @@ fn counts(
 fn measure(m: &Medium, unit_mm: f64) -> CurvatureChannel {
     let sigma_s = m.sigma_s * (1.0 - m.g);
     let sigma_t = m.sigma_a + sigma_s;
-    if !(unit_mm > 0.0) || !(sigma_s > 0.0) || !(sigma_t > 0.0) {
+    // Also NaN: a comparison with it is false.
+    let positive = |x: f64| x > 0.0;
+    if !positive(unit_mm) || !positive(sigma_s) || !positive(sigma_t) {
         return flat(unit_mm);
     }
     let albedo = sigma_s / sigma_t;
@@ -213,10 +215,10 @@ fn ratios(curved: &[u64; ENTRIES], flat: &[u64; ENTRIES], radius_mm: f64, unit_m
 }
 
 impl CurvatureChannel {
-    /// The ratio at chord `r_mm` and curvature `kappa` (1/mm), as the shade pass reads it
-    /// (bssrdf.glsl's `curvature_ratio`).
+    /// The ratio at chord `r_mm` and curvature `kappa` (1/mm), linear between the measured
+    /// entries (the shade pass's table, gpu::sd_table::CurvatureRatios, is made from it).
     pub fn ratio(&self, r_mm: f64, kappa: f64) -> f64 {
-        if !(self.unit_mm > 0.0) {
+        if self.unit_mm.is_nan() || self.unit_mm <= 0.0 {
             return 1.0;
         }
         let (rows, a_row, b_row, f) = self.rows_at(kappa);
