@@ -646,6 +646,9 @@ void main() {
         uvec4 tile = texel(tile_headers, (uint(pixel.y) / list_tile) * tiles_across + uint(pixel.x) / list_tile);
         uint entry = tile.x;
         uint point_count = tile.y & 0xffffu, near_count = tile.y >> 16;
+        // A list built without the near field (no pixel of the tile lit, as tile_cut.comp found
+        // with the same lights and shadow maps): no variate, the plain sum, as the cut has it.
+        if (tile.w != NEAR_FIELD_TILE && tile.w != WALK_FROM_ROOT) own_lit = false;
         // The points within the near field's reach of the tile, with its control variate.
         for (uint e = 0u; e < near_count; ++e) {
             uint index = tile_entry(entry + e);

@@ -75,10 +75,11 @@ macro_rules! record_tile_cut {
     ($r:expr, $k:expr, $rec:expr) => {{
         let (o, lists): (&GpuObject, &TileLists) = (&$r.world.objects[$k], &$r.tile_lists[$k]);
         let h = &o.hierarchy;
-        let position = &$r.targets.position;
+        let surface = (&$r.targets.position, &$r.targets.normal);
+        let lights = (&h.shadows.lights, &h.shadows.shadow_map, &h.shadows.shadow_sampler);
         let params = (&o.params, &$r.frame_params);
         let object = $k as u32;
-        $r.passes.tile_cut.record($rec, params, &h.nodes, &h.sorted_points, position, lists, object)
+        $r.passes.tile_cut.record($rec, params, &h.nodes, &h.sorted_points, surface, lights, lists, object)
     }};
 }
 

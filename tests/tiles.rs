@@ -12,12 +12,17 @@ use translucent::output::relative_rmse;
 use translucent::scene::{bounding_sphere, Camera, Light};
 use translucent::world::World;
 
+type Setup = (Renderer, (World, FrameDesc), std::sync::Arc<translucent::vk::ValidationCounts>);
+
 /// A skin torus at 70x45 with 9000 points and ε = 0.1: the renderer, the world and the frame.
-fn torus_renderer(
-    brute_force: bool,
-) -> (Renderer, (World, FrameDesc), std::sync::Arc<translucent::vk::ValidationCounts>) {
+fn torus_renderer(brute_force: bool) -> Setup {
+    renderer_of("torus", brute_force)
+}
+
+/// `mesh` in skin at 70x45 with 9000 points and ε = 0.1, without the near field.
+fn renderer_of(mesh: &str, brute_force: bool) -> Setup {
     let (ctx, counts) = common::validated_context();
-    let mesh = Mesh::from_spec("torus").unwrap();
+    let mesh = Mesh::from_spec(mesh).unwrap();
     let (centre, radius) = bounding_sphere(&mesh.positions);
     let camera = Camera::framing(centre, radius, 40.0, Vec3::new(0.3, 0.6, 1.0));
     let lights = vec![Light::Directional { toward: Vec3::new(-0.3, 0.7, -0.65), irradiance: Vec3::ONE }];
@@ -126,4 +131,61 @@ fn both_list_tile_sizes_are_as_close_to_brute_force_as_walks_from_the_root() {
         assert!(e < 0.01 && e <= e_root * 1.05, "{e} against the walks' {e_root}");
     }
     assert!(d_small <= d_large, "4x4 lists nearer each pixel's own cut: {d_small} against {d_large}");
+}
+
+/// Only a lit pixel runs the near field's control variate, so the tile cut lists for it (the
+/// nodes within its reach opened, the unlit points there listed) only where a pixel of the tile
+/// is lit. A sphere lit from the side, 8x8 tiles: every tile wholly on its dark side, a fifth of
+/// its radius or more past the terminator, must shade as the plain sum bit for bit, though light
+/// from the lit side within the near field's reach reaches it (listed for the near field, as
+/// before, those tiles differed); the lit side is changed by the near field.
+#[test]
+fn tiles_without_a_lit_pixel_list_no_near_field() {
+    let (mut renderer, (mut world, mut desc), counts) = renderer_of("sphere", false);
+    world.objects[0].samples = Some(2000);
+    (desc.width, desc.height) = (140, 90);
+    renderer.force_list_tile(Some(8)).unwrap();
+    let forward = (desc.camera.target - desc.camera.eye).normalize();
+    let side = forward.cross(desc.camera.up).normalize();
+    desc.lights = vec![Light::Directional { toward: side, irradiance: Vec3::ONE }];
+    let mut images = Vec::new();
+    for near_field in [translucent::frame_desc::NearField::On, translucent::frame_desc::NearField::Off] {
+        desc.integration.near_field = near_field;
+        renderer.render_frame(&world, &desc).unwrap();
+        images.push(renderer.image().unwrap().pixels);
+    }
+    drop(renderer);
+    common::assert_clean(&counts);
+    let (width, height) = (desc.width as usize, desc.height as usize);
+    let (on, off) = (&images[0], &images[1]);
+    // The disc's centre and radius in pixels; its dark half is the dimmer one.
+    let covered: Vec<usize> = (0..width * height).filter(|&i| off[i][3] > 0.0).collect();
+    let xs = || covered.iter().map(|&i| (i % width) as f32);
+    let (lo, hi) = (xs().fold(f32::MAX, f32::min), xs().fold(f32::MIN, f32::max));
+    let (centre, radius) = ((lo + hi) / 2.0, (hi - lo) / 2.0);
+    let half_sum = |left: bool| {
+        covered.iter().filter(|&&i| (((i % width) as f32) < centre) == left).map(|&i| off[i][0]).sum::<f32>()
+    };
+    let dark_left = half_sum(true) < half_sum(false);
+    let dark =
+        |x: usize| if dark_left { (x as f32) < centre - 0.2 * radius } else { (x as f32) > centre + 0.2 * radius };
+    let (mut checked, mut reached, mut differing) = (0, 0, 0);
+    for ty in 0..height.div_ceil(8) {
+        for tx in 0..width.div_ceil(8) {
+            let tile: Vec<usize> = (ty * 8..(ty * 8 + 8).min(height))
+                .flat_map(|y| (tx * 8..(tx * 8 + 8).min(width)).map(move |x| y * width + x))
+                .filter(|&i| off[i][3] > 0.0)
+                .collect();
+            if tile.is_empty() || !tile.iter().all(|&i| dark(i % width)) {
+                continue;
+            }
+            checked += tile.len();
+            reached += tile.iter().filter(|&&i| off[i][0] > 0.0).count();
+            differing += tile.iter().filter(|&&i| on[i] != off[i]).count();
+        }
+    }
+    assert!(checked > 1000 && reached > 200, "dark tiles' pixels {checked}, reached by light {reached}");
+    assert_eq!(differing, 0, "the near field changed {differing} of {checked} pixels of unlit tiles");
+    let lit_changed = covered.iter().filter(|&&i| !dark(i % width) && on[i] != off[i]).count();
+    assert!(lit_changed > 1000, "the near field changed only {lit_changed} pixels of the lit side");
 }

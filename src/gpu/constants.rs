@@ -46,6 +46,9 @@ pub const LIST_TILE_SIZES: [u32; 2] = [4, 8];
 /// A tile header's frontier count meaning "no list: every pixel walks from the root" (the list
 /// did not fit in the buffer this frame).
 pub const WALK_FROM_ROOT: u32 = u32::MAX;
+/// A tile header's last word for a list built for the near field: some pixel of the tile is
+/// lit (0: none is, so the list has no points for the control variate and no pixel runs it).
+pub const NEAR_FIELD_TILE: u32 = 1;
 /// Steps of one tile's walk in the cut pass (it walks twice; llvmpipe ends an invocation's loops
 /// after ~65k iterations in total).
 pub const MAX_CUT_STEPS: u32 = 24000;
@@ -74,6 +77,7 @@ pub const GLSL_CONSTANTS: &[(&str, u32)] = &[
     ("LEAF_BIT", LEAF_BIT),
     ("RADIX_TILE", RADIX_TILE),
     ("WALK_FROM_ROOT", WALK_FROM_ROOT),
+    ("NEAR_FIELD_TILE", NEAR_FIELD_TILE),
     ("MAX_CUT_STEPS", MAX_CUT_STEPS),
     ("MAX_LIST_EVALUATIONS", MAX_LIST_EVALUATIONS),
     ("DIPOLE_TABLE_SIZE", DIPOLE_TABLE_SIZE),

@@ -1,14 +1,15 @@
 //! The tile-cut pass (shaders/tile_cut.comp): per screen tile of 4² or 8² pixels, the list of
 //! tree nodes and points that are far and small enough for every pixel of the tile, so that the
 //! shade pass's lanes for a tile evaluate the same sources in step. Reads: the object's and the frame's parameters,
-//! tree nodes, sorted points, the G-buffer's positions. Writes: tile headers, list entries, the
-//! allocation counter.
+//! tree nodes, sorted points, the G-buffer's positions and normals, the lights and their shadow
+//! maps (whether any pixel of the tile is lit: only then does it need the near field). Writes:
+//! tile headers, list entries, the allocation counter.
 
 use crate::error::Result;
 use crate::gpu::TileCutConstants;
-use crate::vk::{Bind, Buffer, BufferUsageFlags, Context, Image, MemoryLocation, Pipeline, Recorder};
+use crate::vk::{Bind, Buffer, BufferUsageFlags, Context, Image, MemoryLocation, Pipeline, Recorder, Sampler};
 
-pub use crate::gpu::{LIST_TILE_SIZES, WALK_FROM_ROOT};
+pub use crate::gpu::{LIST_TILE_SIZES, NEAR_FIELD_TILE, WALK_FROM_ROOT};
 /// List entries allotted per tile before a frame has told how many it needs.
 const INITIAL_ENTRIES_PER_TILE: u64 = 256;
 
@@ -139,7 +140,8 @@ impl TileCutPass {
         (object_params, frame_params): (&Buffer, &Buffer),
         nodes: &Buffer,
         points: &Buffer,
-        position: &Image,
+        (position, normal): (&Image, &Image),
+        (lights, shadow_map, shadow_sampler): (&Buffer, &Image, &Sampler),
         lists: &TileLists,
         object: u32,
     ) -> Result<()> {
@@ -163,6 +165,9 @@ impl TileCutPass {
                 Bind::Write(&lists.entries),
                 Bind::Write(&lists.allocation),
                 Bind::Uniform(frame_params),
+                Bind::Read(lights),
+                Bind::Sampled(shadow_map, shadow_sampler),
+                Bind::StorageImageRead(normal),
             ],
             bytemuck::bytes_of(&constants),
             [lists.tiles[0].div_ceil(8), lists.tiles[1], 1],
