@@ -838,7 +838,9 @@ void main() {
     if (MODEL == MODEL_MC) {
         // The pixel's own flux: already there where the near field needed it.
         if (!NEAR_FIELD) own_light(xo, no);
-        lo *= table_exit_factor(dipole_table, own_cos_t(), cos_o);
+        // On a curved surface the exit's distribution is the ball's (curvature_exit: less
+        // grazing light leaves a ball than a half-space).
+        lo *= table_exit_factor(dipole_table, own_cos_t(), cos_o) * curvature_exit(dipole_table, pixel_curvature_rows, cos_o);
         if (across_thickness.y > 0.0) {
             float t = across_thickness.x / across_thickness.y;
             lo += fresnel_transmittance(object_params.channels[0].eta, cos_o) * across_sum

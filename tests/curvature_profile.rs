@@ -37,6 +37,18 @@ fn a_ball_returns_more_a_cavity_less_and_flat_is_one() {
         println!("channel {c}: C(L/2; ±1/L) = {ball:.3} / {cavity:.3}");
         assert!(ball > 1.1, "channel {c}: ball {ball}");
         assert!(cavity < 0.95, "channel {c}: cavity {cavity}");
+        // The exit's direction: on a flat surface the half-space's; on a ball of radius L less
+        // light leaves at grazing angles and more near the normal (the walk's escapes within a
+        // chord R√2, normalised), in the red and green, which diffuse furthest (the blue's R is
+        // 5.5 of its mean free paths: nearly flat to it).
+        for cos_o in [0.1, 0.5, 1.0] {
+            assert_eq!(ch.exit_ratio(cos_o, 0.0), 1.0);
+        }
+        let (grazing, normal) = (ch.exit_ratio(0.2, 1.0 / unit), ch.exit_ratio(1.0, 1.0 / unit));
+        println!("channel {c}: exit ratio at κL = 1, cos θo 0.2 / 1: {grazing:.3} / {normal:.3}");
+        if c < 2 {
+            assert!(grazing < 1.0 && normal > 1.0 && normal - grazing > 0.05, "channel {c}: {grazing} / {normal}");
+        }
         // The smallest curvature changes little near the entry.
         let slight = ch.ratio(0.25 * unit, node_curvature(0) / unit);
         assert!((slight - 1.0).abs() < 0.1, "channel {c}: κL = 1/16 gives {slight}");
@@ -77,6 +89,19 @@ fn the_gpu_table_reads_the_ratios() {
     println!("worst relative difference {worst:.4}");
     assert!(worst < 0.01, "{worst}");
     assert_eq!(CurvatureRatios::none().lookup(1.0, 0.5), [1.0; 3]);
+    // The exit distribution's rows: f16, the same interpolation in κ and cos²θo.
+    let mut worst_exit = 0.0f64;
+    for kappa_l in [0.03, 0.2, 0.73, 1.5, 3.0, -0.3, -1.2] {
+        for cos_o in [0.0, 0.1, 0.35, 0.7, 0.9, 1.0] {
+            let gpu = table.lookup_exit(cos_o, kappa_l / unit);
+            for c in 0..3 {
+                worst_exit = worst_exit.max((gpu[c] / channels[c].exit_ratio(cos_o, kappa_l / unit) - 1.0).abs());
+            }
+        }
+    }
+    println!("exit rows: worst relative difference {worst_exit:.5}");
+    assert!(worst_exit < 2e-3, "{worst_exit}");
+    assert_eq!(CurvatureRatios::none().lookup_exit(0.3, 0.5), [1.0; 3]);
 }
 
 #[test]

@@ -310,13 +310,17 @@ pub const CURVATURE_TABLE_ENTRIES: usize = super::CURVATURE_TABLE_ENTRIES as usi
 /// models, which never read the rest), then 2N rows of entries, each texel holding per channel
 /// two neighbouring curvature nodes' ratios as two f16, so that one fetch interpolates in κ: on
 /// each side (convex, then concave) row j holds nodes j − 1 and j, node −1 being the flat
-/// surface (every ratio 1).
+/// surface (every ratio 1). Then the exit distribution's ratios (`curvature_exit`;
+/// [`CurvatureChannel::exit_ratio`]): the same 2N rows of MC_EXIT_BINS texels, paired the same way.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CurvatureRatios {
     pub unit_mm: f32,
     /// Per side, per node, per entry, per channel.
     pub convex: Vec<Vec<[f32; 3]>>,
     pub concave: Vec<Vec<[f32; 3]>>,
+    /// Per side, per node, per exit bin, per channel.
+    pub convex_exit: Vec<Vec<[f32; 3]>>,
+    pub concave_exit: Vec<Vec<[f32; 3]>>,
 }
 
 impl CurvatureRatios {
@@ -325,7 +329,14 @@ impl CurvatureRatios {
     /// No ratios (the models without them): L = 0, every node flat.
     pub fn none() -> CurvatureRatios {
         let flat = vec![vec![[1.0; 3]; CURVATURE_TABLE_ENTRIES]; curvature_profile::CURVATURE_NODES];
-        CurvatureRatios { unit_mm: 0.0, convex: flat.clone(), concave: flat }
+        let flat_exit = vec![vec![[1.0; 3]; mc_profile::EXIT_BINS]; curvature_profile::CURVATURE_NODES];
+        CurvatureRatios {
+            unit_mm: 0.0,
+            convex: flat.clone(),
+            concave: flat,
+            convex_exit: flat_exit.clone(),
+            concave_exit: flat_exit,
+        }
     }
 
     pub fn monte_carlo(channels: &[std::sync::Arc<CurvatureChannel>; 3]) -> CurvatureRatios {
@@ -343,21 +354,42 @@ impl CurvatureRatios {
                 })
                 .collect()
         };
+        let exits = |concave: bool| -> Vec<Vec<[f32; 3]>> {
+            (0..curvature_profile::CURVATURE_NODES)
+                .map(|k| {
+                    (0..mc_profile::EXIT_BINS)
+                        .map(|b| {
+                            [0, 1, 2].map(|c| {
+                                let rows = if concave { &channels[c].concave_exit } else { &channels[c].convex_exit };
+                                rows[k][b] as f32
+                            })
+                        })
+                        .collect()
+                })
+                .collect()
+        };
         if unit.is_nan() || unit <= 0.0 {
             return CurvatureRatios::none();
         }
-        CurvatureRatios { unit_mm: unit as f32, convex: nodes(1.0), concave: nodes(-1.0) }
+        CurvatureRatios {
+            unit_mm: unit as f32,
+            convex: nodes(1.0),
+            concave: nodes(-1.0),
+            convex_exit: exits(false),
+            concave_exit: exits(true),
+        }
     }
 
     pub fn texels(&self) -> Vec<[u32; 4]> {
         let header = std::iter::once([self.unit_mm.to_bits(), 0, 0, 0]);
-        let flat = vec![[1.0f32; 3]; CURVATURE_TABLE_ENTRIES];
-        let side = |nodes: &Vec<Vec<[f32; 3]>>| -> Vec<[u32; 4]> {
+        // Per node j of a side, `len` texels pairing nodes j − 1 (−1: flat) and j.
+        let side = |nodes: &Vec<Vec<[f32; 3]>>, len: usize| -> Vec<[u32; 4]> {
+            let flat = vec![[1.0f32; 3]; len];
             (0..curvature_profile::CURVATURE_NODES)
                 .flat_map(|j| {
                     let lower = if j == 0 { &flat } else { &nodes[j - 1] };
                     let upper = &nodes[j];
-                    (0..CURVATURE_TABLE_ENTRIES)
+                    (0..len)
                         .map(|i| {
                             let pair = |c: usize| half_bits(lower[i][c]) as u32 | (half_bits(upper[i][c]) as u32) << 16;
                             [pair(0), pair(1), pair(2), 0]
@@ -366,7 +398,48 @@ impl CurvatureRatios {
                 })
                 .collect()
         };
-        header.chain(side(&self.convex)).chain(side(&self.concave)).collect()
+        header
+            .chain(side(&self.convex, CURVATURE_TABLE_ENTRIES))
+            .chain(side(&self.concave, CURVATURE_TABLE_ENTRIES))
+            .chain(side(&self.convex_exit, mc_profile::EXIT_BINS))
+            .chain(side(&self.concave_exit, mc_profile::EXIT_BINS))
+            .collect()
+    }
+
+    /// The two nodes of curvature `kappa` (None: flat) and the second's weight, as
+    /// bssrdf.glsl's `curvature_rows`.
+    fn nodes_at(&self, kappa: f64) -> (Option<usize>, usize, f64) {
+        let x = kappa.abs() * self.unit_mm as f64;
+        let first = curvature_profile::node_curvature(0);
+        if x.is_nan() || x < first {
+            return (None, 0, if x.is_nan() { 0.0 } else { x / first });
+        }
+        let k = (x.log2() - curvature_profile::FIRST_CURVATURE_LOG2 as f64)
+            .min((curvature_profile::CURVATURE_NODES - 1) as f64);
+        let i = (k.floor() as usize).min(curvature_profile::CURVATURE_NODES - 2);
+        (Some(i), i + 1, k - i as f64)
+    }
+
+    /// The exit distribution's ratio per channel at exit cosine `cos_o` and curvature `kappa`
+    /// (1/mm), as the shade pass reads it (`curvature_exit`): linear in cos²θo between bin
+    /// centres (held beyond the outer ones), in κ as [`CurvatureRatios::lookup`].
+    pub fn lookup_exit(&self, cos_o: f64, kappa: f64) -> [f64; 3] {
+        let unit = self.unit_mm as f64;
+        if unit.is_nan() || unit <= 0.0 {
+            return [1.0; 3];
+        }
+        let nodes = if kappa < 0.0 { &self.concave_exit } else { &self.convex_exit };
+        let (lower, upper, f) = self.nodes_at(kappa);
+        let y = (cos_o * cos_o * mc_profile::EXIT_BINS as f64 - 0.5).clamp(0.0, (mc_profile::EXIT_BINS - 1) as f64);
+        let j = (y.floor() as usize).min(mc_profile::EXIT_BINS - 2);
+        let value = |v: f32| half_value(half_bits(v));
+        [0, 1, 2].map(|c| {
+            let at = |b: usize| {
+                let a = lower.map_or(1.0, |k| value(nodes[k][b][c]));
+                a + (value(nodes[upper][b][c]) - a) * f
+            };
+            at(j) + (at(j + 1) - at(j)) * (y - j as f64)
+        })
     }
 
     /// The ratio per channel at chord `r_mm` and curvature `kappa` (1/mm), as the shade pass
@@ -378,16 +451,7 @@ impl CurvatureRatios {
             return [1.0; 3];
         }
         let nodes = if kappa < 0.0 { &self.concave } else { &self.convex };
-        let x = kappa.abs() * unit;
-        let first = curvature_profile::node_curvature(0);
-        let (lower, upper, f) = if x < first {
-            (None, 0, x / first)
-        } else {
-            let k = (x.log2() - curvature_profile::FIRST_CURVATURE_LOG2 as f64)
-                .min((curvature_profile::CURVATURE_NODES - 1) as f64);
-            let i = (k.floor() as usize).min(curvature_profile::CURVATURE_NODES - 2);
-            (Some(i), i + 1, k - i as f64)
-        };
+        let (lower, upper, f) = self.nodes_at(kappa);
         let e = ((r_mm / (r_mm + unit) * CURVATURE_TABLE_ENTRIES as f64) as usize).min(CURVATURE_TABLE_ENTRIES - 1);
         let value = |v: f32| half_value(half_bits(v));
         [0, 1, 2].map(|c| {
@@ -398,7 +462,7 @@ impl CurvatureRatios {
     }
 
     /// Texels after the light across.
-    pub const TEXELS: usize = 1 + Self::ROWS * CURVATURE_TABLE_ENTRIES;
+    pub const TEXELS: usize = 1 + Self::ROWS * (CURVATURE_TABLE_ENTRIES + mc_profile::EXIT_BINS);
 }
 
 /// Beam diffusion's entry at `r` of a table of `reach`: Sd, but at r = 0 the v0 for which the
