@@ -214,7 +214,7 @@ fn totals(c: &Counts) -> [u64; ENTRIES] {
 /// The ratio per exit bin of the curved surface's exit distribution to the flat one's, each
 /// normalised over the bins, of the escapes within a chord |R|√2 (at least the first entry):
 /// over three bins (weights 1 2 1, the ends 3 1) for the walks' noise; 1 where either counted
-/// under MIN_COUNT in all.
+/// under MIN_COUNT in all, or in the bin.
 fn exit_ratios(curved: &Counts, flat: &Counts, radius_mm: f64, unit_mm: f64) -> [f64; EXIT_BINS] {
     let cut = entry_of(radius_mm.abs() * std::f64::consts::SQRT_2, unit_mm).unwrap_or(ENTRIES).max(1);
     let bins =
@@ -229,7 +229,14 @@ fn exit_ratios(curved: &Counts, flat: &Counts, radius_mm: f64, unit_mm: f64) -> 
     if n_curved < (MIN_COUNT * EXIT_BINS as u64) as f64 || n_flat < (MIN_COUNT * EXIT_BINS as u64) as f64 {
         return [1.0; EXIT_BINS];
     }
-    std::array::from_fn(|b| (smooth(&curved, b) / n_curved) / (smooth(&flat, b) / n_flat))
+    std::array::from_fn(|b| {
+        // A bin either walk hardly reaches (η < 1: no light leaves at some angles) stays 1.
+        let (c, f) = (smooth(&curved, b), smooth(&flat, b));
+        if c < MIN_COUNT as f64 || f < MIN_COUNT as f64 {
+            return 1.0;
+        }
+        (c / n_curved) / (f / n_flat)
+    })
 }
 
 /// The ratio per entry of `curved` (a sphere of signed radius `radius_mm`) to `flat` counts, held
