@@ -403,6 +403,22 @@ fn keys_pressed_while_a_preview_shades_end_in_the_image_of_the_same_settings() {
     };
     let shot = png("keys-during-preview");
     let _ = std::fs::remove_file(&shot);
+    let xdo = |args: &[&str]| {
+        let mut cmd = Command::new("timeout");
+        cmd.arg("20").arg(xdotool).args(args).env("DISPLAY", &display);
+        let out = cmd.output().expect("run xdotool");
+        String::from_utf8_lossy(&out.stdout).trim().to_string()
+    };
+    // The server takes connections (a viewer started before it did once failed to connect, in
+    // a CI run under load): at most ten seconds.
+    let ready = (0..100).any(|_| {
+        let up = !xdo(&["getdisplaygeometry"]).is_empty();
+        if !up {
+            std::thread::sleep(std::time::Duration::from_millis(100));
+        }
+        up
+    });
+    assert!(ready, "Xvfb on {display} takes no connections");
     // Bounded: a viewer that missed its `q` ends after three minutes, failing the test.
     let viewer = Command::new("timeout")
         .args(["180", env!("CARGO_BIN_EXE_translucent")])
@@ -413,12 +429,6 @@ fn keys_pressed_while_a_preview_shades_end_in_the_image_of_the_same_settings() {
         .stderr(std::process::Stdio::piped())
         .spawn()
         .expect("start the viewer");
-    let xdo = |args: &[&str]| {
-        let mut cmd = Command::new("timeout");
-        cmd.arg("20").arg(xdotool).args(args).env("DISPLAY", &display);
-        let out = cmd.output().expect("run xdotool");
-        String::from_utf8_lossy(&out.stdout).trim().to_string()
-    };
     let mut viewer = viewer;
     let window = (0..600).find_map(|_| {
         let id = xdo(&["search", "--name", "translucent"]);
