@@ -406,20 +406,6 @@ impl CurvatureRatios {
             .collect()
     }
 
-    /// The two nodes of curvature `kappa` (None: flat) and the second's weight, as
-    /// bssrdf.glsl's `curvature_rows`.
-    fn nodes_at(&self, kappa: f64) -> (Option<usize>, usize, f64) {
-        let x = kappa.abs() * self.unit_mm as f64;
-        let first = curvature_profile::node_curvature(0);
-        if x.is_nan() || x < first {
-            return (None, 0, if x.is_nan() { 0.0 } else { x / first });
-        }
-        let k = (x.log2() - curvature_profile::FIRST_CURVATURE_LOG2 as f64)
-            .min((curvature_profile::CURVATURE_NODES - 1) as f64);
-        let i = (k.floor() as usize).min(curvature_profile::CURVATURE_NODES - 2);
-        (Some(i), i + 1, k - i as f64)
-    }
-
     /// The exit distribution's ratio per channel at exit cosine `cos_o` and curvature `kappa`
     /// (1/mm), as the shade pass reads it (`curvature_exit`): linear in cos²θo between bin
     /// centres (held beyond the outer ones), in κ as [`CurvatureRatios::lookup`].
@@ -429,17 +415,21 @@ impl CurvatureRatios {
             return [1.0; 3];
         }
         let nodes = if kappa < 0.0 { &self.concave_exit } else { &self.convex_exit };
-        let (lower, upper, f) = self.nodes_at(kappa);
         let y = (cos_o * cos_o * mc_profile::EXIT_BINS as f64 - 0.5).clamp(0.0, (mc_profile::EXIT_BINS - 1) as f64);
         let j = (y.floor() as usize).min(mc_profile::EXIT_BINS - 2);
-        let value = |v: f32| half_value(half_bits(v));
         [0, 1, 2].map(|c| {
-            let at = |b: usize| {
-                let a = lower.map_or(1.0, |k| value(nodes[k][b][c]));
-                a + (value(nodes[upper][b][c]) - a) * f
-            };
+            let at = |b: usize| self.between_nodes(nodes, kappa, b, c);
             at(j) + (at(j + 1) - at(j)) * (y - j as f64)
         })
+    }
+
+    /// Entry `i` of channel `c` of `nodes` (one side's rows) at curvature `kappa`, as the shade
+    /// pass reads a paired texel: f16, linear between the two nodes of `curvature_profile::nodes_at`.
+    fn between_nodes(&self, nodes: &[Vec<[f32; 3]>], kappa: f64, i: usize, c: usize) -> f64 {
+        let (lower, upper, f) = curvature_profile::nodes_at(kappa * self.unit_mm as f64);
+        let value = |v: f32| half_value(half_bits(v));
+        let a = lower.map_or(1.0, |k| value(nodes[k][i][c]));
+        a + (value(nodes[upper][i][c]) - a) * f
     }
 
     /// The ratio per channel at chord `r_mm` and curvature `kappa` (1/mm), as the shade pass
@@ -451,14 +441,8 @@ impl CurvatureRatios {
             return [1.0; 3];
         }
         let nodes = if kappa < 0.0 { &self.concave } else { &self.convex };
-        let (lower, upper, f) = self.nodes_at(kappa);
         let e = ((r_mm / (r_mm + unit) * CURVATURE_TABLE_ENTRIES as f64) as usize).min(CURVATURE_TABLE_ENTRIES - 1);
-        let value = |v: f32| half_value(half_bits(v));
-        [0, 1, 2].map(|c| {
-            let a = lower.map_or(1.0, |k| value(nodes[k][e][c]));
-            let b = value(nodes[upper][e][c]);
-            a + (b - a) * f
-        })
+        [0, 1, 2].map(|c| self.between_nodes(nodes, kappa, e, c))
     }
 
     /// Texels after the light across.

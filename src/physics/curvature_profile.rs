@@ -58,6 +58,20 @@ pub fn node_curvature(k: usize) -> f64 {
     2f64.powi(k as i32 + FIRST_CURVATURE_LOG2)
 }
 
+/// The two nodes of curvature κL = `kappa_l` (None: the flat surface) and the weight of the
+/// second: linear in κ from flat to node 0, in log κ between nodes, held past the last; NaN
+/// reads as flat. The shade pass's `curvature_rows` and the GPU table's mirror read the same.
+pub fn nodes_at(kappa_l: f64) -> (Option<usize>, usize, f64) {
+    let x = kappa_l.abs();
+    let first = node_curvature(0);
+    if x.is_nan() || x < first {
+        return (None, 0, if x.is_nan() { 0.0 } else { x / first });
+    }
+    let k = (x.log2() - FIRST_CURVATURE_LOG2 as f64).min((CURVATURE_NODES - 1) as f64);
+    let i = (k.floor() as usize).min(CURVATURE_NODES - 2);
+    (Some(i), i + 1, k - i as f64)
+}
+
 /// The centre of entry `i` in u.
 pub fn entry_centre(i: usize) -> f64 {
     (i as f64 + 0.5) / ENTRIES as f64
@@ -298,17 +312,10 @@ impl CurvatureChannel {
         (rows, a, b, f)
     }
 
-    /// The two nodes of curvature `kappa` (None: the flat surface) and the weight of the second:
-    /// linear in κ from flat to node 0, in log κ between nodes, held past the last.
+    /// The two nodes of curvature `kappa` (1/mm; see [`nodes_at`]).
     fn nodes_at(&self, kappa: f64) -> (Option<usize>, Option<usize>, f64) {
-        let x = kappa.abs() * self.unit_mm;
-        let first = node_curvature(0);
-        if x.is_nan() || x < first {
-            return (None, Some(0), if x.is_nan() { 0.0 } else { x / first });
-        }
-        let k = (x.log2() - FIRST_CURVATURE_LOG2 as f64).min((CURVATURE_NODES - 1) as f64);
-        let i = (k.floor() as usize).min(CURVATURE_NODES - 2);
-        (Some(i), Some(i + 1), k - i as f64)
+        let (lower, upper, f) = nodes_at(kappa * self.unit_mm);
+        (lower, Some(upper), f)
     }
 
     /// The exit distribution's ratio at exit cosine `cos_o` (outside) and curvature `kappa`
