@@ -135,7 +135,7 @@ void main() {
     // Whether any pixel of the tile is lit, as the shade pass finds its own irradiance
     // (own_light(), light_irradiance()): only a lit pixel runs the near field's control variate,
     // so a tile with none needs neither the points within reach opened nor the unlit ones listed.
-    // Most of a back-lit object is such (the default frame: shade pass 2.3x faster with them
+    // Most of a back-lit object is such (the default frame: shade pass 1.75x faster with them
     // left out). The shade pass reads the flag from the header, so the two cannot disagree.
     bool lit = false;
     bool near_field = frame_params.near_field != 0u;
