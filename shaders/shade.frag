@@ -20,6 +20,7 @@
 #include "lights.glsl"
 #include "microfacet.glsl"
 #include "tile_lists.glsl"
+#include "far_field.glsl"
 
 // The model, fixed per pipeline: llvmpipe runs both sides of a branch for every SIMD group, so a
 // model chosen at run time would cost both models' arithmetic (measured: the classical dipole
@@ -64,35 +65,11 @@ layout(binding = 16) uniform sampler2DArray shadow_depth;
 // The G-buffer's texture: a translucent pixel's scatter weight (1 where the object has no
 // texture; gpu_world::SurfaceTexture).
 layout(binding = 17, rgba32f) uniform readonly image2D surface_albedo;
-vec4 dipole_header; // its texel 0, read once per pixel
-vec4 slab_header; // the Monte Carlo table's slab header (L in mm, scales), read once per pixel (0 for the other models)
-// The Monte Carlo table's curvature rows at the pixel's mean curvature (curvature_rows): every
-// pair of the pixel is read as on a sphere (or cavity) of the pixel's curvature, smoothed over
-// the longest diffusion length so that its sources' is nearly the same.
-vec4 pixel_curvature_rows;
-float pixel_curvature_mm = 0.0;
-
-// The Monte Carlo table's multiple scattering at xo from a source at (xi, ni) lit from the mean
-// directions `toward[c]` (per channel, toward the lights, per unit power): Sp(r)·(1 + b(r) m·d̂),
-// the azimuthal harmonic of the light's lean, m = −(toward's part along the surface)/η the
-// refracted direction's part along it (|m| = sin θt for one light, shorter where lights
-// differ) and d̂ the direction to xo along xi's surface (so m·d̂ = −toward·d̂/η), times the
-// curvature ratio; r = |d|, d = xo − xi in mm.
-vec3 mc_sd(vec3 d, vec3 ni, vec3 toward[3]) {
-    float r = length(d);
-    vec3 tangential = d - dot(d, ni) * ni;
-    float len = length(tangential);
-    float scale = len > 0.0 ? -1.0 / (object_params.channels[0].eta * len) : 0.0;
-    vec3 lean = scale * vec3(dot(toward[0], tangential), dot(toward[1], tangential), dot(toward[2], tangential));
-    vec3 b;
-    vec3 sd = sd_table_azimuth(dipole_table, dipole_header, r, b);
-    return sd * max(vec3(1.0) + b * lean, vec3(0.0)) * curvature_ratio(dipole_table, pixel_curvature_rows, r);
-}
+// The far-field pass's sixteen sums per 8x8 tile (far_field.comp), as texels.
+layout(binding = 18) uniform usamplerBuffer far_field;
+#include "sources.glsl"
 
 const uint STACK_SIZE = 96u;
-// Points nearer than this many diffusion lengths (1/σtr) of the farthest-reaching channel are
-// evaluated in sigma directions (PointSpread).
-const float SIGMA_DIRECTIONS_REACH = 2.0;
 // Stack entries: a point or node index (below 2^24, with LEAF_BIT for points) and the number of
 // its next evaluation plus one (a node's second sigma point).
 const uint EVALUATION_SHIFT = 24u;
@@ -124,84 +101,6 @@ float near_weight(vec3 xi, vec3 xo) {
     return 1.0 - smoothstep(object_params.near_start_mm, object_params.near_end_mm, length(xo - xi) * object_params.mm_per_unit);
 }
 
-// The Monte Carlo table's light across the object (physics::slab_profile): a source whose
-// normal faces away from the pixel's (w = −ni·no > 0) and lies behind the pixel's tangent plane
-// is read as across a flat slab of thickness t = (xo − xi)·no, at lateral distance ρ, in
-// S = (1 − w) Sp(r) + w T(ρ; t): this returns (1 − w) times the half-space's `sd` and adds
-// w T · `power_mm` to across_sum, and its luminance-weighted thickness to across_thickness (the
-// exit factor h_T is read once per pixel at their mean, main()).
-vec3 across_sum = vec3(0.0);
-vec2 across_thickness = vec2(0.0); // Σ t·luminance, Σ luminance
-vec3 across(vec3 xi, vec3 ni, vec3 xo, vec3 no, vec3 sd, vec3 power_mm) {
-    float w = -dot(ni, no);
-    if (w <= 0.0) return sd;
-    float s = object_params.mm_per_unit;
-    vec3 d = (xo - xi) * s;
-    float t = dot(d, no);
-    if (t <= 0.0) return sd;
-    float rho = length(d - t * no);
-    // Across a ball the measured sphere's transport (the curvature ratio) holds: a pair across
-    // a sphere of radius R is at least R deep (κt ≥ 1), across a flat slab κ = 0.
-    w = min(w, 1.0) * (1.0 - clamp(pixel_curvature_mm * t, 0.0, 1.0));
-    vec3 through = w * slab_transmission(dipole_table, slab_header, rho, t) * power_mm;
-    across_sum += through;
-    float luminance = dot(through, vec3(0.2126, 0.7152, 0.0722));
-    across_thickness += vec2(t * luminance, luminance);
-    return (1.0 - w) * sd;
-}
-
-vec3 source(vec3 xi, vec3 ni, vec3 wi, vec3 power, vec3 xo, vec3 no) {
-    float s = object_params.mm_per_unit;
-    vec3 sd;
-    // Written out, not looped: loop iterations count against llvmpipe's budget (see main).
-    if (MODEL == MODEL_DIRECTIONAL) {
-        // The geometry once for all three channels (they share eta).
-        vec3 xi_mm = xi * s, xo_mm = xo * s;
-        DirpoleGeometry g = dirpole_geometry(xi_mm, ni, wi, xo_mm, no, object_params.channels[0].eta);
-        sd = vec3(dirpole_channel_sd(object_params.channels[0], g, xi_mm, xo_mm, no),
-                  dirpole_channel_sd(object_params.channels[1], g, xi_mm, xo_mm, no),
-                  dirpole_channel_sd(object_params.channels[2], g, xi_mm, xo_mm, no));
-    } else if (MODEL == MODEL_MC) {
-        vec3 toward[3] = vec3[](wi, wi, wi);
-        sd = across(xi, ni, xo, no, mc_sd((xo - xi) * s, ni, toward), power * (s * s));
-    } else {
-        sd = dipole_sd_table(dipole_table, dipole_header, length(xo - xi) * s);
-    }
-    return sd * power * (s * s); // power is irradiance × scene-unit area: to mm²
-}
-
-// Every light's flux from xi at once: `power` (irradiance × scene-unit area) per channel, and
-// `incident` (PointFlux's sums times the area): the power-weighted sum of the refracted
-// directions, at the source's normal ni, is -(Σωi - (Σωi·ni)ni)/η - ni Σcos θt.
-// `dw` moves every channel's mean refracted direction (a sigma direction, see PointSpread).
-vec3 merged_source(vec3 xi, vec3 ni, vec3 power, vec4 incident[3], vec3 dw, vec3 xo, vec3 no, bool across_object) {
-    float s = object_params.mm_per_unit;
-    vec3 sd;
-    if (MODEL == MODEL_DIRECTIONAL) {
-        // The geometry once; per channel only its mean refracted direction (equal for lights of
-        // one colour, different under an environment).
-        vec3 xi_mm = xi * s, xo_mm = xo * s;
-        float inv_eta = 1.0 / object_params.channels[0].eta;
-        vec3 w[3];
-        for (uint c = 0u; c < 3u; ++c) {
-            vec3 t = incident[c].xyz - dot(incident[c].xyz, ni) * ni;
-            w[c] = power[c] > 0.0 ? (-t * inv_eta - ni * incident[c].w) / power[c] + dw : vec3(0.0);
-        }
-        DirpoleGeometry g = dirpole_geometry_refracted(xi_mm, ni, w[0], xo_mm, no);
-        sd.x = dirpole_channel_sd(object_params.channels[0], g, xi_mm, xo_mm, no);
-        sd.y = dirpole_channel_sd(object_params.channels[1], with_refracted(g, w[1], no), xi_mm, xo_mm, no);
-        sd.z = dirpole_channel_sd(object_params.channels[2], with_refracted(g, w[2], no), xi_mm, xo_mm, no);
-    } else if (MODEL == MODEL_MC) {
-        // Each channel's mean direction toward its lights: Σ E ωi / Σ E (the merged record's).
-        vec3 toward[3];
-        for (uint c = 0u; c < 3u; ++c) toward[c] = power[c] > 0.0 ? incident[c].xyz / power[c] : vec3(0.0);
-        sd = mc_sd((xo - xi) * s, ni, toward);
-        if (across_object) sd = across(xi, ni, xo, no, sd, power * (s * s));
-    } else {
-        sd = dipole_sd_table(dipole_table, dipole_header, length(xo - xi) * s);
-    }
-    return sd * power * (s * s); // power is irradiance × scene-unit area: to mm²
-}
 
 // Where the surface between xo and a source xi bends, the source is put where the surface
 // unfolded into xo's tangent plane would carry it: xi turned about the line where the two
@@ -359,59 +258,6 @@ vec3 point_light_source(uint record, uint light_count, vec3 xo, vec3 no) {
     return source(position_area.xyz, normal, decode_oct(l.w), irradiance * position_area.w, xo, no);
 }
 
-// Point `index` as a merged source: its position, power and flux (times its area).
-void point_source(uint index, out vec3 xi, out vec3 power, out vec4 incident[3], out float area) {
-    vec4 position_area = texel_float(points, index * POINT_TEXELS);
-    xi = position_area.xyz;
-    area = position_area.w;
-    power = texel_float(points, index * POINT_TEXELS + 2u).xyz * position_area.w;
-    for (uint c = 0u; c < 3u; ++c) incident[c] = texel_float(point_flux, index * POINT_FLUX_TEXELS + c) * position_area.w;
-}
-
-// Point `index` evaluated on its own (the near field): its mean refracted directions, or, where
-// the lights' directions spread (PointSpread), four sigma directions of a quarter power each.
-// Returns the evaluations made.
-vec3 point_evaluated(uint index, vec3 xi, vec3 ni, vec3 power, vec4 incident[3], vec3 xo, vec3 no, out uint made) {
-    vec3 a0 = texel_float(point_spread, index * POINT_SPREAD_TEXELS).xyz;
-    vec3 a1 = texel_float(point_spread, index * POINT_SPREAD_TEXELS + 1u).xyz;
-    // Beyond two diffusion lengths of the farthest-reaching channel the source's curvature in ω12
-    // no longer shows (measured: the sigma directions changed nothing there).
-    float reach = SIGMA_DIRECTIONS_REACH / min(min(object_params.channels[0].sigma_tr, object_params.channels[1].sigma_tr),
-                                               object_params.channels[2].sigma_tr);
-    bool near = length(xo - xi) * object_params.mm_per_unit < reach;
-    // The table models' Sd is radial: the sigma directions would sum to the one evaluation.
-    if (MODEL != MODEL_DIRECTIONAL || ONE_LIGHT || (a0 == vec3(0.0) && a1 == vec3(0.0)) || !near) {
-        made = 1u;
-        return merged_source(xi, ni, power, incident, vec3(0.0), xo, no, true);
-    }
-    made = 4u;
-    vec3 q = 0.25 * power;
-    vec4 iq[3];
-    for (uint c = 0u; c < 3u; ++c) iq[c] = 0.25 * incident[c];
-    return merged_source(xi, ni, q, iq, a0, xo, no, true) + merged_source(xi, ni, q, iq, -a0, xo, no, true)
-         + merged_source(xi, ni, q, iq, a1, xo, no, true) + merged_source(xi, ni, q, iq, -a1, xo, no, true);
-}
-
-// The two sources of node `index` used whole: sigma points center ± offset, each with half the
-// power. A node used whole is not one source at its power centre c: Sd is convex in distance, so that
-// underestimates it (1-1.5% on a slab). Two sigma points c ± s(u + t), s² = spread²/2 per axis of
-// the node's tangent plane (u toward xo, t across), match the points' mean and second moments, so
-// Sd's curvature along u and t is taken into account to second order.
-// `area`: half the node's (an unlit node's sigma points are both at its centre).
-void node_sigma(uint index, vec3 ni, vec3 xo, out vec3 center, out vec3 offset, out vec3 power, out vec4 incident[3],
-                out float area) {
-    uint record = index * NODE_FLUX_TEXELS;
-    vec4 power_area = texel_float(nodes, index * NODE_TEXELS);
-    power = 0.5 * power_area.xyz;
-    area = 0.5 * power_area.w;
-    for (uint c = 0u; c < 3u; ++c) incident[c] = 0.5 * texel_float(node_flux, record + c);
-    vec4 center_spread = texel_float(node_flux, record + 3u);
-    center = center_spread.xyz;
-    vec3 towards_xo = xo - center;
-    vec3 u = towards_xo - ni * dot(towards_xo, ni);
-    u = dot(u, u) > 0.0 ? normalize(u) : normalize(cross(ni, abs(ni.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0)));
-    offset = sqrt(0.5 * center_spread.w) * (u + cross(ni, u));
-}
 
 // Whether the box [lo, hi] (scene units) reaches within the near field's end of xo.
 bool within_near_reach(vec3 xo, vec3 lo, vec3 hi) {
@@ -661,11 +507,7 @@ void main() {
     vec4 normal_curvature = imageLoad(surface_normal, pixel);
     vec3 no = normalize(normal_curvature.xyz);
     own_weight = imageLoad(surface_albedo, pixel).rgb;
-    dipole_header = dipole_table_header(dipole_table);
-    slab_header = MODEL == MODEL_MC ? slab_header_of(dipole_table) : vec4(0.0);
-    if (MODEL == MODEL_MC) pixel_curvature_mm = normal_curvature.w / object_params.mm_per_unit;
-    pixel_curvature_rows = MODEL == MODEL_MC ? curvature_rows(dipole_table, pixel_curvature_mm)
-                                             : vec4(-1.0, 0.0, 0.0, 1.0);
+    begin_sources(normal_curvature);
     vec3 wo = normalize(pc.eye.xyz - xo);
     vec3 sum = vec3(0.0);
     uint visits = 0u;
@@ -697,7 +539,8 @@ void main() {
         // together and load the same records.
         uint list_tile = pc.point_range.w;
         uint tiles_across = (uint(imageSize(surface_position).x) + list_tile - 1u) / list_tile;
-        uvec4 tile = texel(tile_headers, (uint(pixel.y) / list_tile) * tiles_across + uint(pixel.x) / list_tile);
+        uint tile_index = (uint(pixel.y) / list_tile) * tiles_across + uint(pixel.x) / list_tile;
+        uvec4 tile = texel(tile_headers, tile_index);
         uint entry = tile.x;
         uint point_count = tile.y & 0xffffu, near_count = tile.y >> 16;
         // A list built without the near field (no pixel of the tile lit, as tile_cut.comp found
@@ -715,7 +558,7 @@ void main() {
             float v = near_correction(xi, ni, area, xo, no, evaluations);
             if (power == vec3(0.0)) continue;
             uint made;
-            vec3 f = point_evaluated(index, xi, ni, power, incident, xo, no, made);
+            vec3 f = point_evaluated(index, xi, ni, power, incident, xo, no, xo, made);
             sum += f;
             near_sources += v * f;
             evaluations += made;
@@ -730,7 +573,7 @@ void main() {
             if (power == vec3(0.0)) continue;
             vec3 ni = texel_float(points, index * POINT_TEXELS + 1u).xyz;
             uint made;
-            sum += point_evaluated(index, xi, ni, power, incident, xo, no, made);
+            sum += point_evaluated(index, xi, ni, power, incident, xo, no, xo, made);
             evaluations += made;
         }
         evaluated += point_count;
@@ -752,6 +595,15 @@ void main() {
                  + merged_source(center - offset, ni, power, incident, vec3(0.0), xo, no, true);
         }
         visits += tile.z;
+        // The tile's far sources (none where the tile has no far field: its sums are 0), summed
+        // at sixteen of its pixels by the far-field pass and interpolated here.
+        if (frame_params.far_field != 0u && list_tile == FAR_FIELD_TILE) {
+            ivec2 at = pixel % int(FAR_FIELD_TILE);
+            vec4 wu = far_weights(float(at.x)), wv = far_weights(float(at.y));
+            for (uint k = 0u; k < FAR_FIELD_SAMPLES; ++k) {
+                sum += (wu[k % 4u] * wv[k / 4u]) * texel_float(far_field, tile_index * FAR_FIELD_SAMPLES + k).xyz;
+            }
+        }
 
         // A tile whose list did not fit this frame: each pixel walks the tree from the root with
         // its own stack. Points are pushed like nodes, so that each step evaluates at most
@@ -829,7 +681,7 @@ void main() {
                     float v = near_correction(xi, ni, area, xo, no, evaluations);
                     if (power == vec3(0.0)) continue;
                     uint made;
-                    vec3 f = point_evaluated(index, xi, ni, power, incident, xo, no, made);
+                    vec3 f = point_evaluated(index, xi, ni, power, incident, xo, no, xo, made);
                     evaluations += made;
                     sum += f;
                     near_sources += v * f;

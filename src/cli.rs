@@ -432,6 +432,11 @@ pub struct RenderArgs {
     /// with the tree, not with --brute-force (the exact point sum, the reference).
     #[arg(long, value_enum, default_value = "auto")]
     pub near_field: NearFieldArg,
+    /// Evaluate every source at every pixel: by default the sources far from an 8x8 tile of the
+    /// image (where its pixels are finer than the sample points) are summed at nine of its pixels
+    /// and interpolated, within about 0.1% of each source's contribution.
+    #[arg(long)]
+    pub no_far_field: bool,
     /// Leave out the surface's own (microfacet) reflection: subsurface scattering alone.
     #[arg(long)]
     pub no_specular: bool,

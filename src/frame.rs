@@ -17,12 +17,13 @@ use crate::output::{self, Exposure, HdrImage};
 use crate::passes::background::BackgroundPass;
 use crate::passes::debug_view::{self, DebugViewPass};
 use crate::passes::diffuse::DiffusePass;
+use crate::passes::far_field::{FarFieldInputs, FarFieldPass};
 use crate::passes::irradiance::IrradiancePass;
 use crate::passes::sampling::SamplingPass;
 use crate::passes::shade::{self, ShadeInputs, ShadePass, SurfaceDraw};
 use crate::passes::shadow::ShadowPass;
 use crate::passes::sort::SortPass;
-use crate::passes::tile_cut::{list_tile, TileCutPass, TileLists};
+use crate::passes::tile_cut::{list_tile, TileCutPass, TileLists, FAR_FIELD_TILE};
 use crate::passes::tonemap::{self, TonemapPass};
 use crate::passes::tree::TreePass;
 use crate::shadows::Shadows;
@@ -64,6 +65,7 @@ macro_rules! shade_inputs {
             point_spread: &o.hierarchy.sorted_point_spread,
             tile_headers: &lists.headers,
             tile_entries: &lists.entries,
+            far_field: &lists.far_field,
             list_tile: lists.list_tile,
             sd_table: &o.sd_table,
         }
@@ -72,14 +74,14 @@ macro_rules! shade_inputs {
 
 /// Records the tile-cut pass of object `k` (a macro for the same reason as `shade_inputs`).
 macro_rules! record_tile_cut {
-    ($r:expr, $k:expr, $rec:expr) => {{
+    ($r:expr, $k:expr, $rec:expr, $model:expr) => {{
         let (o, lists): (&GpuObject, &TileLists) = (&$r.world.objects[$k], &$r.tile_lists[$k]);
         let h = &o.hierarchy;
         let surface = (&$r.targets.position, &$r.targets.normal);
         let lights = (&h.shadows.lights, &h.shadows.shadow_map, &h.shadows.shadow_sampler);
         let params = (&o.params, &$r.frame_params);
         let object = $k as u32;
-        $r.passes.tile_cut.record($rec, params, &h.nodes, &h.sorted_points, surface, lights, lists, object)
+        $r.passes.tile_cut.record($rec, params, &h.nodes, &h.sorted_points, surface, lights, lists, (object, $model))
     }};
 }
 
@@ -390,6 +392,7 @@ impl Renderer {
 struct Passes {
     hierarchy: HierarchyPasses,
     tile_cut: TileCutPass,
+    far_field: FarFieldPass,
     shade: ShadePass,
     debug_view: DebugViewPass,
     diffuse: DiffusePass,
@@ -402,6 +405,7 @@ impl Passes {
         Ok(Passes {
             hierarchy: HierarchyPasses::new(ctx)?,
             tile_cut: TileCutPass::new(ctx)?,
+            far_field: FarFieldPass::default(),
             shade: ShadePass::new(ctx)?,
             debug_view: DebugViewPass::new(ctx)?,
             diffuse: DiffusePass::new(ctx)?,
@@ -558,7 +562,8 @@ impl Renderer {
                 specular: desc.specular as u32,
                 roughness: desc.roughness,
                 near_field: integration.splits_near_field() as u32,
-                pad: [0; 2],
+                far_field: integration.uses_far_field() as u32,
+                pad: 0,
             }],
         )?;
         self.generation += 1;
@@ -570,6 +575,7 @@ impl Renderer {
             self.passes.shade.prepare(&self.ctx, shade_variant(&desc), integration.brute_force)?;
         }
         let cut = shading && !integration.brute_force;
+        let far_field = integration.uses_far_field();
         let objects = self.world.objects.len();
         let w = &self.world;
         let opaque_meshes = w.opaque.iter().map(|o| (&o.vertices, &o.indices, o.index_count));
@@ -642,7 +648,7 @@ impl Renderer {
             for k in 0..objects {
                 if cut {
                     // Per tile, the sources of this object far enough for every pixel of it.
-                    rec.scope("tile cut", |rec| record_tile_cut!(self, k, rec))?;
+                    rec.scope("tile cut", |rec| record_tile_cut!(self, k, rec, integration.model))?;
                 } else {
                     // Brute force reads no lists; still, nothing the shader may load is left
                     // undefined.
@@ -661,9 +667,36 @@ impl Renderer {
                 // lists as big as this frame needs.
                 self.tile_lists[k] = lists;
                 self.ctx.submit(self.profiler.as_mut(), |rec| {
-                    rec.scope("tile cut", |rec| record_tile_cut!(self, k, rec))
+                    rec.scope("tile cut", |rec| record_tile_cut!(self, k, rec, integration.model))
                 })?;
             }
+        }
+        // The far field of the objects whose lists are of 8x8 tiles: after the last cut.
+        let far: Vec<usize> =
+            (0..objects).filter(|&k| cut && far_field && self.tile_lists[k].list_tile == FAR_FIELD_TILE).collect();
+        if !far.is_empty() {
+            let variant = (integration.model, desc.lights.len() == 1);
+            self.passes.far_field.prepare(&self.ctx, variant.0, variant.1)?;
+            self.ctx.submit(self.profiler.as_mut(), |rec| {
+                rec.scope("far field", |rec| {
+                    far.iter().try_for_each(|&k| {
+                        let (o, t) = (&self.world.objects[k], &self.targets);
+                        let h = &o.hierarchy;
+                        let inputs = FarFieldInputs {
+                            object_params: &o.params,
+                            nodes: &h.nodes,
+                            points: &h.sorted_points,
+                            node_flux: &h.node_flux,
+                            point_flux: &h.sorted_point_flux,
+                            point_spread: &h.sorted_point_spread,
+                            sd_table: &o.sd_table,
+                            position: &t.position,
+                            normal: &t.normal,
+                        };
+                        self.passes.far_field.record(rec, variant, &inputs, &self.tile_lists[k], k as u32)
+                    })
+                })
+            })?;
         }
         Ok(FrameInProgress {
             // A debug view costs what it draws: no subsurface shading under it (the pre-pass's

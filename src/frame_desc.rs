@@ -52,6 +52,11 @@ pub struct Integration {
     /// Whether each pixel's sum is split into the near field (the pixel's own irradiance times a
     /// fixed quadrature of Sd) and the far (the sources, weighted down near the pixel).
     pub near_field: NearField,
+    /// Whether the sources far from an 8x8 list tile are summed at nine of its pixels and
+    /// interpolated (shaders/far_field.comp) instead of at every pixel. Where it applies: with the
+    /// tree, not the Monte Carlo table (whose light across an object is not smooth across a
+    /// tile), in tiles that qualify (tile_cut.comp).
+    pub far_field: bool,
 }
 
 /// When the near-field split applies (see [`Integration::near_field`]).
@@ -65,6 +70,11 @@ pub enum NearField {
 }
 
 impl Integration {
+    /// Whether this frame sums far sources per tile (see [`Integration::far_field`]).
+    pub fn uses_far_field(&self) -> bool {
+        self.far_field && !self.brute_force && self.model != Model::Mc
+    }
+
     /// Whether this frame splits off the near field.
     pub fn splits_near_field(&self) -> bool {
         match self.near_field {
@@ -83,6 +93,7 @@ impl Default for Integration {
             epsilon: DEFAULT_EPSILON,
             brute_force: false,
             near_field: NearField::Auto,
+            far_field: true,
         }
     }
 }

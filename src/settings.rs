@@ -253,6 +253,7 @@ impl RenderSettings {
             epsilon: args.epsilon,
             brute_force: args.brute_force,
             near_field: args.near_field.into(),
+            far_field: !args.no_far_field,
         };
         (d.width, d.height) = (args.width, args.height);
         (d.specular, d.roughness) = (!args.no_specular, args.roughness);

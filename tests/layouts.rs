@@ -46,6 +46,7 @@ fn shading_params_and_tree_match_glsl() {
             offset_of!(FrameParams, specular),
             offset_of!(FrameParams, roughness),
             offset_of!(FrameParams, near_field),
+            offset_of!(FrameParams, far_field),
         ]
         .iter()
         .map(|&o| o as u32)
@@ -193,9 +194,16 @@ fn push_constants_match_glsl() {
         offset_of!(TileCutConstants, capacity),
         offset_of!(TileCutConstants, object),
         offset_of!(TileCutConstants, list_tile),
-        offset_of!(TileCutConstants, pad1),
+        offset_of!(TileCutConstants, model),
     ];
     assert_eq!(offsets("tile_cut.comp", "TileCutConstants"), cut.map(|o| o as u32));
+    use translucent::gpu::FarFieldConstants;
+    let far = [
+        offset_of!(FarFieldConstants, tiles),
+        offset_of!(FarFieldConstants, object),
+        offset_of!(FarFieldConstants, pad),
+    ];
+    assert_eq!(offsets("far_field.comp", "FarFieldConstants"), far.map(|o| o as u32));
     // The surface pass, and the opaque objects' shading.
     use translucent::gpu::{DiffuseConstants, SurfaceConstants};
     let surface = [

@@ -17,7 +17,7 @@ fn shade_frag_declares_its_buffers_texels_and_images() {
     assert_eq!(r.stage, Stage::Fragment);
     let numbers: Vec<u32> = r.bindings.iter().map(|b| b.binding).collect();
     assert_eq!(numbers, (0..numbers.len() as u32).collect::<Vec<_>>(), "bindings 0..n in order");
-    assert_eq!(r.bindings.len(), 18, "{:?}", r.bindings);
+    assert_eq!(r.bindings.len(), 19, "{:?}", r.bindings);
     for b in &r.bindings {
         assert_eq!((b.set, b.count), (0, 1), "{b:?}");
         let expected = match b.binding {
@@ -31,7 +31,8 @@ fn shade_frag_declares_its_buffers_texels_and_images() {
             5 | 16 => (DescriptorKind::CombinedImageSampler, true),
             // The G-buffer's position, normal and texture (the scatter weight), read.
             8 | 9 | 17 => (DescriptorKind::StorageImage, true),
-            // Nodes, points, their light records, the tile lists and the dipole table: texels.
+            // Nodes, points, their light records, the tile lists, the dipole table and the far
+            // field's sums: texels.
             _ => (DescriptorKind::UniformTexelBuffer, true),
         };
         assert_eq!((b.kind, b.read_only), expected, "{b:?}");

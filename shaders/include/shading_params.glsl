@@ -26,7 +26,7 @@ struct FrameParams {
     uint specular;             // 1: add the microfacet lobe (--no-specular: 0)
     float roughness;           // of the microfacet lobe; alpha = roughness²
     uint near_field;           // 1: split each pixel's sum into the near field and the far (see ObjectParams)
-    uint pad1;
+    uint far_field;            // 1: sources far from an 8x8 tile are summed at nine of its pixels (far_field.comp)
     uint pad2;
 };
 #endif

@@ -43,6 +43,11 @@ pub const RADIX_TILE: u32 = 256;
 /// (`passes::tile_cut::list_tile`): 8x8 = 64 pixels, a multiple of a GPU warp or wave, or 4x4,
 /// llvmpipe's fragment block, where an 8x8 tile would span more than 1.5 point spacings.
 pub const LIST_TILE_SIZES: [u32; 2] = [4, 8];
+/// The list tiles that split off a far field (shaders/far_field.comp): the large ones, where a
+/// tile spans less than 1.5 point spacings, so that most of its sources are far from it.
+pub const FAR_FIELD_TILE: u32 = LIST_TILE_SIZES[1];
+/// The pixels of such a tile at which its far field is summed (4 x 4, include/far_field.glsl).
+pub const FAR_FIELD_SAMPLES: u32 = 16;
 /// A tile header's frontier count meaning "no list: every pixel walks from the root" (the list
 /// did not fit in the buffer this frame).
 pub const WALK_FROM_ROOT: u32 = u32::MAX;
@@ -78,6 +83,8 @@ pub const GLSL_CONSTANTS: &[(&str, u32)] = &[
     ("RADIX_TILE", RADIX_TILE),
     ("WALK_FROM_ROOT", WALK_FROM_ROOT),
     ("NEAR_FIELD_TILE", NEAR_FIELD_TILE),
+    ("FAR_FIELD_TILE", FAR_FIELD_TILE),
+    ("FAR_FIELD_SAMPLES", FAR_FIELD_SAMPLES),
     ("MAX_CUT_STEPS", MAX_CUT_STEPS),
     ("MAX_LIST_EVALUATIONS", MAX_LIST_EVALUATIONS),
     ("DIPOLE_TABLE_SIZE", DIPOLE_TABLE_SIZE),

@@ -114,6 +114,17 @@ pub struct DebugConstants {
     pub color_scale: Vec4,
 }
 
+/// Push constants of shaders/far_field.comp.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct FarFieldConstants {
+    /// 8x8 tiles across and down.
+    pub tiles: [u32; 2],
+    /// The object whose pixels and tree the far field is of.
+    pub object: u32,
+    pub pad: u32,
+}
+
 /// Push constants of shaders/tile_cut.comp.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
@@ -128,5 +139,6 @@ pub struct TileCutConstants {
     pub object: u32,
     /// Pixels per side of a tile.
     pub list_tile: u32,
-    pub pad1: u32,
+    /// The frame's model (`Model::gpu_code`): whether the normal enters Sd (the far field's test).
+    pub model: u32,
 }

@@ -108,5 +108,8 @@ pub struct FrameParams {
     pub roughness: f32,
     /// 1 to split each pixel's sum into the near field and the far (see [`ObjectParams`]).
     pub near_field: u32,
-    pub pad: [u32; 2],
+    /// 1 to sum the sources far from an 8x8 list tile at nine of its pixels and interpolate
+    /// (shaders/far_field.comp).
+    pub far_field: u32,
+    pub pad: u32,
 }

@@ -4,6 +4,7 @@ pub mod background;
 pub mod bssrdf_eval;
 pub mod debug_view;
 pub mod diffuse;
+pub mod far_field;
 pub mod irradiance;
 pub mod sampling;
 pub mod shade;

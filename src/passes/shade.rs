@@ -58,6 +58,8 @@ pub struct ShadeInputs<'a> {
     pub sd_table: &'a Buffer,
     /// The tile-cut pass's lists (headers and entries), and their tiles' pixels per side.
     pub tile_headers: &'a Buffer,
+    /// The far-field pass's nine sums per 8x8 tile (read where the frame uses the far field).
+    pub far_field: &'a Buffer,
     pub tile_entries: &'a Buffer,
     pub list_tile: u32,
 }
@@ -278,6 +280,7 @@ impl ShadePass {
             Bind::Texels(inputs.point_spread),
             Bind::Sampled(inputs.shadow_map, inputs.depth_sampler),
             Bind::StorageImageRead(inputs.albedo),
+            Bind::Texels(inputs.far_field),
         ];
         let mut c = *constants;
         c.point_range = glam::UVec4::new(unit.first_point, unit.point_count, unit.object, inputs.list_tile);

@@ -3,13 +3,15 @@
 //! shade pass's lanes for a tile evaluate the same sources in step. Reads: the object's and the frame's parameters,
 //! tree nodes, sorted points, the G-buffer's positions and normals, the lights and their shadow
 //! maps (whether any pixel of the tile is lit: only then does it need the near field). Writes:
-//! tile headers, list entries, the allocation counter.
+//! tile headers, list entries, the allocation counter, and per 8x8 tile the header of its far
+//! sources (passes/far_field.rs sums them).
 
 use crate::error::Result;
 use crate::gpu::TileCutConstants;
+use crate::physics::Model;
 use crate::vk::{Bind, Buffer, BufferUsageFlags, Context, Image, MemoryLocation, Pipeline, Recorder, Sampler};
 
-pub use crate::gpu::{LIST_TILE_SIZES, NEAR_FIELD_TILE, WALK_FROM_ROOT};
+pub use crate::gpu::{FAR_FIELD_SAMPLES, FAR_FIELD_TILE, LIST_TILE_SIZES, NEAR_FIELD_TILE, WALK_FROM_ROOT};
 /// List entries allotted per tile before a frame has told how many it needs.
 const INITIAL_ENTRIES_PER_TILE: u64 = 256;
 
@@ -37,6 +39,10 @@ pub fn list_tile(pixel_footprint: f32, point_spacing: f32, subgroup_size: u32) -
 pub struct TileLists {
     pub headers: Buffer,
     pub entries: Buffer,
+    /// Per tile, where its far sources are in `entries` (tile_cut.comp's far_headers).
+    pub far_headers: Buffer,
+    /// Per 8x8 tile, the far-field pass's nine sums (vec4 each).
+    pub far_field: Buffer,
     allocation: Buffer,
     /// Entries the buffer holds.
     pub capacity: u64,
@@ -67,8 +73,17 @@ impl TileLists {
         // TRANSFER_DST: frames without a cut clear the headers.
         let usage =
             BufferUsageFlags::STORAGE_BUFFER | BufferUsageFlags::UNIFORM_TEXEL_BUFFER | BufferUsageFlags::TRANSFER_DST;
+        let far_tiles = tiles_of(FAR_FIELD_TILE);
         Ok(TileLists {
             headers: Buffer::new(ctx, "tile list headers", tile_count * 16, usage, MemoryLocation::GpuOnly)?,
+            far_headers: Buffer::new(ctx, "far-field headers", tile_count * 16, usage, MemoryLocation::GpuOnly)?,
+            far_field: Buffer::new(
+                ctx,
+                "far-field sums",
+                far_tiles * FAR_FIELD_SAMPLES as u64 * 16,
+                usage,
+                MemoryLocation::GpuOnly,
+            )?,
             // Whole texels of 4 entries.
             entries: Buffer::new(
                 ctx,
@@ -143,7 +158,7 @@ impl TileCutPass {
         (position, normal): (&Image, &Image),
         (lights, shadow_map, shadow_sampler): (&Buffer, &Image, &Sampler),
         lists: &TileLists,
-        object: u32,
+        (object, model): (u32, Model),
     ) -> Result<()> {
         rec.fill_buffer(&lists.allocation, 0)?;
         let constants = TileCutConstants {
@@ -152,7 +167,7 @@ impl TileCutPass {
             capacity: lists.capacity.min(u32::MAX as u64) as u32,
             object,
             list_tile: lists.list_tile,
-            pad1: 0,
+            model: model.gpu_code(),
         };
         rec.dispatch(
             &self.pipeline,
@@ -168,6 +183,7 @@ impl TileCutPass {
                 Bind::Read(lights),
                 Bind::Sampled(shadow_map, shadow_sampler),
                 Bind::StorageImageRead(normal),
+                Bind::Write(&lists.far_headers),
             ],
             bytemuck::bytes_of(&constants),
             [lists.tiles[0].div_ceil(8), lists.tiles[1], 1],

@@ -279,12 +279,23 @@ impl Pipeline {
     /// A compute pipeline running `shader` (its path under `shaders/`); its layout is what the
     /// shader declares.
     pub fn compute(ctx: &Context, shader: &str) -> Result<Pipeline> {
+        Pipeline::compute_specialized(ctx, shader, &[])
+    }
+
+    /// A compute pipeline whose specialisation constant i (constant_id = i) is `specialization[i]`.
+    pub fn compute_specialized(ctx: &Context, shader: &str, specialization: &[u32]) -> Result<Pipeline> {
         let module = Module::new(ctx, shader)?.expect(vk::ShaderStageFlags::COMPUTE)?;
         let layouts = Layouts::new(ctx, shader, &[&module])?;
+        let entries: Vec<vk::SpecializationMapEntry> = (0..specialization.len() as u32)
+            .map(|i| vk::SpecializationMapEntry { constant_id: i, offset: 4 * i, size: 4 })
+            .collect();
+        let specialization_info =
+            vk::SpecializationInfo::default().map_entries(&entries).data(bytemuck::cast_slice(specialization));
         let stage = vk::PipelineShaderStageCreateInfo::default()
             .stage(vk::ShaderStageFlags::COMPUTE)
             .module(module.raw)
-            .name(c"main");
+            .name(c"main")
+            .specialization_info(&specialization_info);
         let info = [vk::ComputePipelineCreateInfo::default().stage(stage).layout(layouts.layout)];
         // SAFETY: valid module and layout.
         let raw = unsafe { ctx.device().create_compute_pipelines(vk::PipelineCache::null(), &info, None) }

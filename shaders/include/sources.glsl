@@ -1,0 +1,184 @@
+// The BSSRDF's sources as the shade pass (shade.frag) and the far-field pass (far_field.comp)
+// evaluate them, so that both compute the same sum: points and nodes of the tree, every light
+// merged into one record per source (PointFlux, NodeFlux), through the model fixed per pipeline.
+// The including shader declares, before including this file: the specialisation constants MODEL
+// and ONE_LIGHT, `object_params` (ObjectParams), and the texel buffers `nodes`, `points`,
+// `node_flux`, `point_flux`, `point_spread` and `dipole_table`; and calls begin_sources() once per
+// pixel before any source.
+#ifndef SOURCES_GLSL
+#define SOURCES_GLSL
+vec4 dipole_header; // its texel 0, read once per pixel
+vec4 slab_header; // the Monte Carlo table's slab header (L in mm, scales), read once per pixel (0 for the other models)
+// The Monte Carlo table's curvature rows at the pixel's mean curvature (curvature_rows): every
+// pair of the pixel is read as on a sphere (or cavity) of the pixel's curvature, smoothed over
+// the longest diffusion length so that its sources' is nearly the same.
+vec4 pixel_curvature_rows;
+float pixel_curvature_mm = 0.0;
+
+// The Monte Carlo table's multiple scattering at xo from a source at (xi, ni) lit from the mean
+// directions `toward[c]` (per channel, toward the lights, per unit power): Sp(r)·(1 + b(r) m·d̂),
+// the azimuthal harmonic of the light's lean, m = −(toward's part along the surface)/η the
+// refracted direction's part along it (|m| = sin θt for one light, shorter where lights
+// differ) and d̂ the direction to xo along xi's surface (so m·d̂ = −toward·d̂/η), times the
+// curvature ratio; r = |d|, d = xo − xi in mm.
+vec3 mc_sd(vec3 d, vec3 ni, vec3 toward[3]) {
+    float r = length(d);
+    vec3 tangential = d - dot(d, ni) * ni;
+    float len = length(tangential);
+    float scale = len > 0.0 ? -1.0 / (object_params.channels[0].eta * len) : 0.0;
+    vec3 lean = scale * vec3(dot(toward[0], tangential), dot(toward[1], tangential), dot(toward[2], tangential));
+    vec3 b;
+    vec3 sd = sd_table_azimuth(dipole_table, dipole_header, r, b);
+    return sd * max(vec3(1.0) + b * lean, vec3(0.0)) * curvature_ratio(dipole_table, pixel_curvature_rows, r);
+}
+
+// Points nearer than this many diffusion lengths (1/σtr) of the farthest-reaching channel are
+// evaluated in sigma directions (PointSpread).
+const float SIGMA_DIRECTIONS_REACH = 2.0;
+
+// The Monte Carlo table's light across the object (physics::slab_profile): a source whose
+// normal faces away from the pixel's (w = −ni·no > 0) and lies behind the pixel's tangent plane
+// is read as across a flat slab of thickness t = (xo − xi)·no, at lateral distance ρ, in
+// S = (1 − w) Sp(r) + w T(ρ; t): this returns (1 − w) times the half-space's `sd` and adds
+// w T · `power_mm` to across_sum, and its luminance-weighted thickness to across_thickness (the
+// exit factor h_T is read once per pixel at their mean, main()).
+vec3 across_sum = vec3(0.0);
+vec2 across_thickness = vec2(0.0); // Σ t·luminance, Σ luminance
+vec3 across(vec3 xi, vec3 ni, vec3 xo, vec3 no, vec3 sd, vec3 power_mm) {
+    float w = -dot(ni, no);
+    if (w <= 0.0) return sd;
+    float s = object_params.mm_per_unit;
+    vec3 d = (xo - xi) * s;
+    float t = dot(d, no);
+    if (t <= 0.0) return sd;
+    float rho = length(d - t * no);
+    // Across a ball the measured sphere's transport (the curvature ratio) holds: a pair across
+    // a sphere of radius R is at least R deep (κt ≥ 1), across a flat slab κ = 0.
+    w = min(w, 1.0) * (1.0 - clamp(pixel_curvature_mm * t, 0.0, 1.0));
+    vec3 through = w * slab_transmission(dipole_table, slab_header, rho, t) * power_mm;
+    across_sum += through;
+    float luminance = dot(through, vec3(0.2126, 0.7152, 0.0722));
+    across_thickness += vec2(t * luminance, luminance);
+    return (1.0 - w) * sd;
+}
+
+vec3 source(vec3 xi, vec3 ni, vec3 wi, vec3 power, vec3 xo, vec3 no) {
+    float s = object_params.mm_per_unit;
+    vec3 sd;
+    // Written out, not looped: loop iterations count against llvmpipe's budget (see main).
+    if (MODEL == MODEL_DIRECTIONAL) {
+        // The geometry once for all three channels (they share eta).
+        vec3 xi_mm = xi * s, xo_mm = xo * s;
+        DirpoleGeometry g = dirpole_geometry(xi_mm, ni, wi, xo_mm, no, object_params.channels[0].eta);
+        sd = vec3(dirpole_channel_sd(object_params.channels[0], g, xi_mm, xo_mm, no),
+                  dirpole_channel_sd(object_params.channels[1], g, xi_mm, xo_mm, no),
+                  dirpole_channel_sd(object_params.channels[2], g, xi_mm, xo_mm, no));
+    } else if (MODEL == MODEL_MC) {
+        vec3 toward[3] = vec3[](wi, wi, wi);
+        sd = across(xi, ni, xo, no, mc_sd((xo - xi) * s, ni, toward), power * (s * s));
+    } else {
+        sd = dipole_sd_table(dipole_table, dipole_header, length(xo - xi) * s);
+    }
+    return sd * power * (s * s); // power is irradiance × scene-unit area: to mm²
+}
+
+// Every light's flux from xi at once: `power` (irradiance × scene-unit area) per channel, and
+// `incident` (PointFlux's sums times the area): the power-weighted sum of the refracted
+// directions, at the source's normal ni, is -(Σωi - (Σωi·ni)ni)/η - ni Σcos θt.
+// `dw` moves every channel's mean refracted direction (a sigma direction, see PointSpread).
+vec3 merged_source(vec3 xi, vec3 ni, vec3 power, vec4 incident[3], vec3 dw, vec3 xo, vec3 no, bool across_object) {
+    float s = object_params.mm_per_unit;
+    vec3 sd;
+    if (MODEL == MODEL_DIRECTIONAL) {
+        // The geometry once; per channel only its mean refracted direction (equal for lights of
+        // one colour, different under an environment).
+        vec3 xi_mm = xi * s, xo_mm = xo * s;
+        float inv_eta = 1.0 / object_params.channels[0].eta;
+        vec3 w[3];
+        for (uint c = 0u; c < 3u; ++c) {
+            vec3 t = incident[c].xyz - dot(incident[c].xyz, ni) * ni;
+            w[c] = power[c] > 0.0 ? (-t * inv_eta - ni * incident[c].w) / power[c] + dw : vec3(0.0);
+        }
+        DirpoleGeometry g = dirpole_geometry_refracted(xi_mm, ni, w[0], xo_mm, no);
+        sd.x = dirpole_channel_sd(object_params.channels[0], g, xi_mm, xo_mm, no);
+        sd.y = dirpole_channel_sd(object_params.channels[1], with_refracted(g, w[1], no), xi_mm, xo_mm, no);
+        sd.z = dirpole_channel_sd(object_params.channels[2], with_refracted(g, w[2], no), xi_mm, xo_mm, no);
+    } else if (MODEL == MODEL_MC) {
+        // Each channel's mean direction toward its lights: Σ E ωi / Σ E (the merged record's).
+        vec3 toward[3];
+        for (uint c = 0u; c < 3u; ++c) toward[c] = power[c] > 0.0 ? incident[c].xyz / power[c] : vec3(0.0);
+        sd = mc_sd((xo - xi) * s, ni, toward);
+        if (across_object) sd = across(xi, ni, xo, no, sd, power * (s * s));
+    } else {
+        sd = dipole_sd_table(dipole_table, dipole_header, length(xo - xi) * s);
+    }
+    return sd * power * (s * s); // power is irradiance × scene-unit area: to mm²
+}
+
+// Point `index` as a merged source: its position, power and flux (times its area).
+void point_source(uint index, out vec3 xi, out vec3 power, out vec4 incident[3], out float area) {
+    vec4 position_area = texel_float(points, index * POINT_TEXELS);
+    xi = position_area.xyz;
+    area = position_area.w;
+    power = texel_float(points, index * POINT_TEXELS + 2u).xyz * position_area.w;
+    for (uint c = 0u; c < 3u; ++c) incident[c] = texel_float(point_flux, index * POINT_FLUX_TEXELS + c) * position_area.w;
+}
+
+// Point `index` evaluated on its own (the near field): its mean refracted directions, or, where
+// the lights' directions spread (PointSpread), four sigma directions of a quarter power each.
+// Returns the evaluations made.
+// `spread_from`: the place whose distance from xi decides whether the spread shows (xo, or for the
+// far field of a tile its centre, so that every pixel of the tile takes the same choice).
+vec3 point_evaluated(uint index, vec3 xi, vec3 ni, vec3 power, vec4 incident[3], vec3 xo, vec3 no, vec3 spread_from,
+                     out uint made) {
+    vec3 a0 = texel_float(point_spread, index * POINT_SPREAD_TEXELS).xyz;
+    vec3 a1 = texel_float(point_spread, index * POINT_SPREAD_TEXELS + 1u).xyz;
+    // Beyond two diffusion lengths of the farthest-reaching channel the source's curvature in ω12
+    // no longer shows (measured: the sigma directions changed nothing there).
+    float reach = SIGMA_DIRECTIONS_REACH / min(min(object_params.channels[0].sigma_tr, object_params.channels[1].sigma_tr),
+                                               object_params.channels[2].sigma_tr);
+    bool near = length(spread_from - xi) * object_params.mm_per_unit < reach;
+    // The table models' Sd is radial: the sigma directions would sum to the one evaluation.
+    if (MODEL != MODEL_DIRECTIONAL || ONE_LIGHT || (a0 == vec3(0.0) && a1 == vec3(0.0)) || !near) {
+        made = 1u;
+        return merged_source(xi, ni, power, incident, vec3(0.0), xo, no, true);
+    }
+    made = 4u;
+    vec3 q = 0.25 * power;
+    vec4 iq[3];
+    for (uint c = 0u; c < 3u; ++c) iq[c] = 0.25 * incident[c];
+    return merged_source(xi, ni, q, iq, a0, xo, no, true) + merged_source(xi, ni, q, iq, -a0, xo, no, true)
+         + merged_source(xi, ni, q, iq, a1, xo, no, true) + merged_source(xi, ni, q, iq, -a1, xo, no, true);
+}
+
+// The two sources of node `index` used whole: sigma points center ± offset, each with half the
+// power. A node used whole is not one source at its power centre c: Sd is convex in distance, so that
+// underestimates it (1-1.5% on a slab). Two sigma points c ± s(u + t), s² = spread²/2 per axis of
+// the node's tangent plane (u toward xo, t across), match the points' mean and second moments, so
+// Sd's curvature along u and t is taken into account to second order.
+// `area`: half the node's (an unlit node's sigma points are both at its centre).
+void node_sigma(uint index, vec3 ni, vec3 xo, out vec3 center, out vec3 offset, out vec3 power, out vec4 incident[3],
+                out float area) {
+    uint record = index * NODE_FLUX_TEXELS;
+    vec4 power_area = texel_float(nodes, index * NODE_TEXELS);
+    power = 0.5 * power_area.xyz;
+    area = 0.5 * power_area.w;
+    for (uint c = 0u; c < 3u; ++c) incident[c] = 0.5 * texel_float(node_flux, record + c);
+    vec4 center_spread = texel_float(node_flux, record + 3u);
+    center = center_spread.xyz;
+    vec3 towards_xo = xo - center;
+    vec3 u = towards_xo - ni * dot(towards_xo, ni);
+    u = dot(u, u) > 0.0 ? normalize(u) : normalize(cross(ni, abs(ni.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0)));
+    offset = sqrt(0.5 * center_spread.w) * (u + cross(ni, u));
+}
+
+// The per-pixel state of the sources above, from the pixel's normal and mean curvature (the
+// G-buffer's normal texel: xyz the normal, w the curvature in 1 / scene units).
+void begin_sources(vec4 normal_curvature) {
+    dipole_header = dipole_table_header(dipole_table);
+    slab_header = MODEL == MODEL_MC ? slab_header_of(dipole_table) : vec4(0.0);
+    if (MODEL == MODEL_MC) pixel_curvature_mm = normal_curvature.w / object_params.mm_per_unit;
+    pixel_curvature_rows = MODEL == MODEL_MC ? curvature_rows(dipole_table, pixel_curvature_mm)
+                                             : vec4(-1.0, 0.0, 0.0, 1.0);
+}
+#endif
