@@ -23,7 +23,7 @@ use crate::passes::sampling::SamplingPass;
 use crate::passes::shade::{self, ShadeInputs, ShadePass, SurfaceDraw};
 use crate::passes::shadow::ShadowPass;
 use crate::passes::sort::SortPass;
-use crate::passes::tile_cut::{list_tile, TileCutPass, TileLists, FAR_FIELD_TILE};
+use crate::passes::tile_cut::{initial_entries_per_tile, list_tile, TileCutPass, TileLists, FAR_FIELD_TILE};
 use crate::passes::tonemap::{self, TonemapPass};
 use crate::passes::tree::TreePass;
 use crate::shadows::Shadows;
@@ -548,8 +548,11 @@ impl Renderer {
             lists.set_list_tile(tile_of(o));
         }
         while self.tile_lists.len() < self.world.objects.len() {
-            let (limit, size) = (self.tile_list_limit, tile_of(&self.world.objects[self.tile_lists.len()]));
-            self.tile_lists.push(TileLists::new(&self.ctx, (desc.width, desc.height), size, None, limit)?);
+            let o = &self.world.objects[self.tile_lists.len()];
+            let (limit, size) = (self.tile_list_limit, tile_of(o));
+            let tiles = desc.width.div_ceil(size) as u64 * desc.height.div_ceil(size) as u64;
+            let capacity = tiles * initial_entries_per_tile(desc.integration.epsilon, o.hierarchy.point_count);
+            self.tile_lists.push(TileLists::new(&self.ctx, (desc.width, desc.height), size, Some(capacity), limit)?);
         }
         let desc = desc.clone();
         let integration = desc.integration;
