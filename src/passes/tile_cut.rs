@@ -16,14 +16,15 @@ pub use crate::gpu::{FAR_FIELD_SAMPLES, FAR_FIELD_TILE, LIST_TILE_SIZES, NEAR_FI
 const INITIAL_ENTRIES_PER_TILE: u64 = 256;
 
 /// List entries to allot per tile before a frame has told how many it needs: 256 at the default
-/// ε = 0.2 (the default frames' lists fit), and as many more as ε is smaller (a cut holds about
-/// ∫ dA / (ε d²) nodes, ∝ 1/ε), but never more than the tree's points and nodes (2N). A list
+/// ε = 0.2 (the default frames' lists fit), and √(0.2/ε) times that below it (a cut holds about
+/// ∫ dA / (ε d²) nodes, up to 1/ε times more, but allotting that much over-allots: pbrt-v2's
+/// scene needs about 400 per tile at ε = 0.05, where 1/ε allotted 1024), never more than the
+/// tree's points and nodes (2N). A list
 /// that does not fit makes the frame cut twice: pbrt-v2's scene (ε = 0.05, 3,100 points, about
 /// 400 entries per 8x8 tile) spent 160 ms of its single frame's 1.5 s on the second cut.
 pub fn initial_entries_per_tile(epsilon: f32, points: u32) -> u64 {
-    let scaled = (INITIAL_ENTRIES_PER_TILE as f64
-        * (crate::frame_desc::DEFAULT_EPSILON as f64 / epsilon as f64).max(1.0))
-    .min(1e9) as u64;
+    let ratio = (crate::frame_desc::DEFAULT_EPSILON as f64 / epsilon as f64).max(1.0);
+    let scaled = (INITIAL_ENTRIES_PER_TILE as f64 * ratio.sqrt()).min(1e9) as u64;
     scaled.min(2 * points as u64).max(4)
 }
 
@@ -208,15 +209,15 @@ impl TileCutPass {
 mod tests {
     use super::*;
 
-    /// 256 entries per tile at the default ε, four times that at ε / 4, never more than the
-    /// points and nodes, never fewer than 256 at a coarser ε.
+    /// 256 entries per tile at the default ε, twice that at ε / 4, never more than the points
+    /// and nodes, never fewer than 256 at a coarser ε.
     #[test]
     fn initial_lists_grow_as_epsilon_shrinks_up_to_the_tree() {
         assert_eq!(initial_entries_per_tile(0.2, 100_000), 256);
-        assert_eq!(initial_entries_per_tile(0.05, 100_000), 1024);
-        assert_eq!(initial_entries_per_tile(0.05, 300), 600);
+        assert_eq!(initial_entries_per_tile(0.05, 100_000), 512);
+        assert_eq!(initial_entries_per_tile(0.05, 200), 400);
         assert_eq!(initial_entries_per_tile(1.0, 100_000), 256);
-        assert_eq!(initial_entries_per_tile(1e-30, 100_000), 200_000);
+        assert_eq!(initial_entries_per_tile(1e-20, 100_000), 200_000);
     }
 
     /// The small tile where the large one spans more than 1.5 spacings and a subgroup fits in 16
