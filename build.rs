@@ -65,39 +65,51 @@ fn main() {
         let name = path.strip_prefix(&shader_root).unwrap().to_string_lossy().replace('\\', "/");
         let source = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
 
-        let mut options = shaderc::CompileOptions::new().unwrap();
-        options.set_target_env(shaderc::TargetEnv::Vulkan, shaderc::EnvVersion::Vulkan1_3 as u32);
-        options.set_target_spirv(shaderc::SpirvVersion::V1_6);
-        options.set_source_language(shaderc::SourceLanguage::GLSL);
-        options.set_warnings_as_errors();
-        // Debug info always: it keeps OpName, which the layout tests read to match Rust structs with
-        // GLSL blocks, and costs the driver nothing. Release builds are optimised on top.
-        options.set_generate_debug_info();
-        if release {
-            options.set_optimization_level(shaderc::OptimizationLevel::Performance);
-        }
-        let (include_root, generated_root) = (include_root.clone(), generated_root.clone());
-        options.set_include_callback(move |requested, _ty, requester, _depth| {
-            let beside = Path::new(requester).parent().map(|p| p.join(requested));
-            let candidates =
-                beside.into_iter().chain([include_root.join(requested), generated_root.join(requested)]);
-            for candidate in candidates {
-                if let Ok(content) = std::fs::read_to_string(&candidate) {
-                    return Ok(shaderc::ResolvedInclude { resolved_name: candidate.display().to_string(), content });
+        // The shade pass is also compiled once per model with the model a constant (SHADE_MODEL):
+        // a module with every model's code took lavapipe 120-150 ms to make a pipeline of.
+        let variants: Vec<(String, Option<u32>)> = if name == "shade.frag" {
+            std::iter::once((name.clone(), None)).chain((0..4).map(|k| (format!("{name}.model{k}"), Some(k)))).collect()
+        } else {
+            vec![(name.clone(), None)]
+        };
+        for (name, model) in variants {
+            let mut options = shaderc::CompileOptions::new().unwrap();
+            options.set_target_env(shaderc::TargetEnv::Vulkan, shaderc::EnvVersion::Vulkan1_3 as u32);
+            options.set_target_spirv(shaderc::SpirvVersion::V1_6);
+            options.set_source_language(shaderc::SourceLanguage::GLSL);
+            options.set_warnings_as_errors();
+            if let Some(k) = model {
+                options.add_macro_definition("SHADE_MODEL", Some(&format!("{k}u")));
+            }
+            // Debug info always: it keeps OpName, which the layout tests read to match Rust structs with
+            // GLSL blocks. Release builds are optimised on top.
+            options.set_generate_debug_info();
+            if release {
+                options.set_optimization_level(shaderc::OptimizationLevel::Performance);
+            }
+            let (include_root, generated_root) = (include_root.clone(), generated_root.clone());
+            options.set_include_callback(move |requested, _ty, requester, _depth| {
+                let beside = Path::new(requester).parent().map(|p| p.join(requested));
+                let candidates =
+                    beside.into_iter().chain([include_root.join(requested), generated_root.join(requested)]);
+                for candidate in candidates {
+                    if let Ok(content) = std::fs::read_to_string(&candidate) {
+                        return Ok(shaderc::ResolvedInclude { resolved_name: candidate.display().to_string(), content });
+                    }
                 }
-            }
-            Err(format!(
-                "cannot find include \"{requested}\" (looked beside {requester}, in {INCLUDE_DIR}/ and among the generated headers)"
-            ))
-        });
+                Err(format!(
+                    "cannot find include \"{requested}\" (looked beside {requester}, in {INCLUDE_DIR}/ and among the generated headers)"
+                ))
+            });
 
-        match compiler.compile_into_spirv(&source, kind, &path.display().to_string(), "main", Some(&options)) {
-            Ok(artifact) => {
-                let spv = out_dir.join(format!("{}.spv", name.replace('/', "__")));
-                std::fs::write(&spv, artifact.as_binary_u8()).unwrap();
-                writeln!(table, "    ({name:?}, include_bytes!({:?})),", spv.display().to_string()).unwrap();
+            match compiler.compile_into_spirv(&source, kind, &path.display().to_string(), "main", Some(&options)) {
+                Ok(artifact) => {
+                    let spv = out_dir.join(format!("{}.spv", name.replace('/', "__")));
+                    std::fs::write(&spv, artifact.as_binary_u8()).unwrap();
+                    writeln!(table, "    ({name:?}, include_bytes!({:?})),", spv.display().to_string()).unwrap();
+                }
+                Err(e) => failures.push(e.to_string()),
             }
-            Err(e) => failures.push(e.to_string()),
         }
     }
     // Headers are tracked too, so editing an include rebuilds its users.

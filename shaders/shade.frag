@@ -25,7 +25,14 @@
 // The model, fixed per pipeline: llvmpipe runs both sides of a branch for every SIMD group, so a
 // model chosen at run time would cost both models' arithmetic (measured: the classical dipole
 // took 2.4x longer beside the directional one's dead code).
+// The pipelines use the module compiled with SHADE_MODEL defined (build.rs, one per model): a
+// module with every model's code took lavapipe 120-150 ms to make a pipeline of, against a
+// frame's 50 ms at 8x8 pixels.
+#ifdef SHADE_MODEL
+const uint MODEL = SHADE_MODEL;
+#else
 layout(constant_id = 0) const uint MODEL = 0u; // 0 directional dipole, 1 classical dipole, 2 beam diffusion, 3 Monte Carlo table (1-3: table)
+#endif
 // Whether the near field is split off (see near_field()), fixed per pipeline for the same reason:
 // a frame without it pays nothing for its code.
 layout(constant_id = 1) const bool NEAR_FIELD = false;
@@ -496,7 +503,24 @@ vec3 single_scattering(vec3 xo, vec3 no, vec3 wo) {
     return ft_o / (eta * eta) * sigma_s * (1.0 / (4.0 * 3.14159265358979323846)) * sum;
 }
 
+// Every binding stays in every model's module (a branch no frame takes: no list tile is 0 pixels
+// a side), so that they share one pipeline layout and one list of resources.
+void keep_every_binding() {
+    uint any = texel(nodes, 0u).x + texel(points, 0u).x + work.objects[0].pixels + light_set.light_count
+        + texel(point_lights, 0u).x + texel(node_flux, 0u).x + texel(tile_headers, 0u).x + texel(tile_entries, 0u).x
+        + texel(dipole_table, 0u).x + texel(point_flux, 0u).x + texel(point_spread, 0u).x + texel(far_field, 0u).x
+        + frame_params.brute_force + object_params.point_count;
+    vec4 images = imageLoad(surface_position, ivec2(0)) + imageLoad(surface_normal, ivec2(0))
+        + imageLoad(surface_albedo, ivec2(0)) + texture(shadow_depth, vec3(0.0))
+        + vec4(shadow_visibility(0u, vec3(0.0), vec3(0.0, 0.0, 1.0)));
+    radiance = images + vec4(float(any));
+}
+
 void main() {
+    if (pc.point_range.w == 0u) {
+        keep_every_binding();
+        return;
+    }
     ivec2 pixel = ivec2(gl_FragCoord.xy);
     vec4 surface = imageLoad(surface_position, pixel);
     // No surface: the background pass drew it.

@@ -180,7 +180,9 @@ impl ShadeVariant {
 }
 
 fn shading_pipeline(ctx: &Context, variant: ShadeVariant, additive_blend: bool) -> Result<Pipeline> {
-    full_screen_pipeline(ctx, "shade.frag", additive_blend, &variant.specialization())
+    // The module compiled for the model (build.rs), its constant_id 0 unused.
+    let module = format!("shade.frag.model{}", variant.model.gpu_code());
+    full_screen_pipeline(ctx, &module, additive_blend, &variant.specialization())
 }
 
 /// A mesh (positions and normals) to the G-buffer, depth-tested, through `vertex_shader` and
