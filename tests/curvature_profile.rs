@@ -14,7 +14,7 @@ use translucent::gpu::sd_table::{self, CurvatureRatios};
 use translucent::materials::Material;
 use translucent::physics::curvature_profile::{self, node_curvature, CURVATURE_NODES};
 use translucent::physics::mc_profile::McProfile;
-use translucent::physics::{fresnel, sphere, Medium};
+use translucent::physics::{fresnel, halfspace, sphere, Medium};
 
 fn skin1() -> [Medium; 3] {
     let m = Material::find("skin1").expect("preset");
@@ -198,5 +198,162 @@ fn the_front_lit_sphere_at_its_pole_matches_the_walk() {
         if c < 2 {
             assert!(flat / truth < 0.93, "channel {c}: the flat half-space {:.3} of the walk", flat / truth);
         }
+    }
+}
+
+/// Ten-degree rings of exit polar angle (from the light's axis) over a front-lit sphere's lit half.
+const RINGS: usize = 9;
+
+/// One channel of a front-lit sphere of radius `r_mm`, ring by ring: the walk's exitance of two or
+/// more scatterings against the renderer's sum over the lit hemisphere at the ring's middle (each
+/// source's lean toward the exit, the ratio at the chord), each source weighted by `incidence`
+/// (1: the renderer's). Returns per ring (model / walk, the walk's relative noise).
+fn rings(
+    m: &Medium,
+    ratios: &curvature_profile::CurvatureChannel,
+    r_mm: f64,
+    incidence: impl Fn(f64) -> f64,
+) -> Vec<(f64, f64)> {
+    let sigma_t = m.sigma_a + m.sigma_s * (1.0 - m.g);
+    let (albedo, radius) = (m.sigma_s * (1.0 - m.g) / sigma_t, r_mm * sigma_t);
+    let centre = DVec3::new(0.0, 0.0, -radius);
+    // Photons on a stratified grid over the disc (equal areas), weighted by Fresnel transmittance.
+    let (discs, angles) = (400u64, 800u64);
+    let photons = discs * angles;
+    let (mut weighted, mut counts) = ([0.0f64; RINGS], [0u64; RINGS]);
+    for i in 0..photons {
+        let (k, j) = (i / angles, i % angles);
+        let rho = radius * ((k as f64 + 0.5) / discs as f64).sqrt();
+        let phi = 2.0 * PI * (j as f64 + 0.5 * (k % 2) as f64) / angles as f64;
+        let p = DVec3::new(rho * phi.cos(), rho * phi.sin(), -radius + (radius * radius - rho * rho).max(0.0).sqrt());
+        let n = (p - centre) / radius;
+        let cos_i = n.z.clamp(0.0, 1.0);
+        let ft = fresnel::transmittance(m.eta, cos_i);
+        let cos_t = (1.0 - (1.0 - cos_i * cos_i) / (m.eta * m.eta)).max(0.0).sqrt();
+        let t = ((DVec3::new(0.0, 0.0, -1.0) + cos_i * n) / m.eta - cos_t * n).normalize();
+        let seed = 0x1234_5678 ^ i.wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        sphere::trace_from((albedo, m.eta, radius), p, t, (seed, 100_000), |e| {
+            let b = ((e.geodesic / radius) / (PI / 2.0) * RINGS as f64) as usize;
+            if e.scatterings >= 2 && b < RINGS {
+                weighted[b] += ft;
+                counts[b] += 1;
+            }
+        });
+    }
+    let profile = McProfile::of(m);
+    (0..RINGS)
+        .map(|b| {
+            let (a0, a1) = (b as f64 / RINGS as f64 * PI / 2.0, (b + 1) as f64 / RINGS as f64 * PI / 2.0);
+            let area = 2.0 * PI * r_mm * r_mm * (a0.cos() - a1.cos());
+            let truth = weighted[b] * (PI * r_mm * r_mm / photons as f64) / area;
+            let a = 0.5 * (a0 + a1);
+            let xo = r_mm * DVec3::new(a.sin(), 0.0, a.cos());
+            let steps = 400;
+            let mut model = 0.0;
+            for k in 0..steps {
+                let theta = (k as f64 + 0.5) / steps as f64 * PI / 2.0;
+                let cos_i = theta.cos();
+                let cos_t = (1.0 - (1.0 - cos_i * cos_i) / (m.eta * m.eta)).max(0.0).sqrt();
+                let sin_t = (1.0 - cos_t * cos_t).sqrt();
+                let w = cos_i
+                    * fresnel::transmittance(m.eta, cos_i)
+                    * profile.incidence_factor(cos_t)
+                    * incidence(cos_i)
+                    * r_mm
+                    * r_mm
+                    * theta.sin()
+                    * (PI / 2.0 / steps as f64)
+                    * (2.0 * PI / steps as f64);
+                for q in 0..steps {
+                    let ph = (q as f64 + 0.5) / steps as f64 * 2.0 * PI;
+                    let n = DVec3::new(theta.sin() * ph.cos(), theta.sin() * ph.sin(), theta.cos());
+                    let d = xo - r_mm * n;
+                    let chord = d.length();
+                    // The source's lean: its light's direction along the surface against the way
+                    // to the exit (the merged records' m·d̂).
+                    let (ahead, along) = (DVec3::new(0.0, 0.0, -1.0) + cos_i * n, d - d.dot(n) * n);
+                    let cos_phi = if ahead.length() > 1e-9 && along.length() > 1e-9 {
+                        ahead.normalize().dot(along.normalize())
+                    } else {
+                        0.0
+                    };
+                    let lean = (1.0 + profile.azimuth_factor(chord) * sin_t * cos_phi).max(0.0);
+                    model += w * profile.exitance(chord) * lean * ratios.ratio(chord, 1.0 / r_mm);
+                }
+            }
+            (model / truth, 1.0 / (counts[b].max(1) as f64).sqrt())
+        })
+        .collect()
+}
+
+/// A 10 mm Marble sphere lit from the front, ring by ring from the pole to the silhouette: the
+/// model within 3% of the walk in every ring and channel. Measured: 0.99–1.02 (noise 0.5–1.3%).
+/// Skin1 and Potato, whose diffusion lengths are longer against the radius, are not: see
+/// `the_front_lit_sphere_ring_by_ring` below.
+#[test]
+fn the_front_lit_marble_sphere_matches_the_walk_ring_by_ring() {
+    let m3 = Material::find("marble").expect("preset");
+    let media = [0, 1, 2].map(|c| m3.channel(c));
+    let ratios = curvature_profile::of_channels(&media);
+    for c in 0..3 {
+        let r = rings(&media[c], &ratios[c], 5.0, |_| 1.0);
+        println!("channel {c}: {:?}", r.iter().map(|(x, n)| format!("{x:.3} ±{:.1}%", 100.0 * n)).collect::<Vec<_>>());
+        for (k, (ratio, _)) in r.iter().enumerate() {
+            assert!((ratio - 1.0).abs() < 0.03, "channel {c}, ring {k}: model {ratio:.3} of the walk");
+        }
+    }
+}
+
+/// The same for any preset (`MATERIAL=potato`, default skin1), printed, with one more column:
+/// each source weighted by how the ball's multiply scattered escapes over the half-space's (same
+/// seeds) change with the angle of incidence, which the ratios C(r; κ), measured at normal
+/// incidence, leave out. A diagnostic (issue #30):
+/// `MATERIAL=skin1 cargo test --release --test curvature_profile -- --ignored --nocapture`.
+/// Measured for Skin1 (R/G/B): 0.95/0.94/1.02 at the pole rising to 1.11/1.11/1.08 at 65°;
+/// Potato 0.97/0.96/0.92 to 1.08/1.09/1.15; the incidence weighting lowers the outer rings by
+/// at most 3.5% (red).
+#[test]
+#[ignore]
+fn the_front_lit_sphere_ring_by_ring() {
+    let material = std::env::var("MATERIAL").unwrap_or_else(|_| "skin1".into());
+    let m3 = Material::find(&material).expect("preset");
+    let media = [0, 1, 2].map(|c| m3.channel(c));
+    let ratios = curvature_profile::of_channels(&media);
+    let r_mm = 5.0;
+    for c in 0..3 {
+        let m = media[c];
+        let sigma_t = m.sigma_a + m.sigma_s * (1.0 - m.g);
+        let (albedo, radius) = (m.sigma_s * (1.0 - m.g) / sigma_t, r_mm * sigma_t);
+        let cos_nodes: [f64; 8] = [1.0, 0.85, 0.7, 0.55, 0.4, 0.25, 0.1, 0.0];
+        let totals: Vec<f64> = cos_nodes
+            .iter()
+            .map(|&cos_i| {
+                let start = halfspace::entry_direction(m.eta, cos_i.max(1e-3));
+                let (mut ball, mut plane) = (0u64, 0u64);
+                for p in 0..200_000u64 {
+                    let seed = 0xc0a7 ^ p.wrapping_mul(0x9E37_79B9_7F4A_7C15);
+                    sphere::trace_sphere(albedo, m.eta, radius, start, 1, (seed, 100_000), |e| {
+                        ball += (e.scatterings >= 2) as u64
+                    });
+                    halfspace::trace_half_space(albedo, m.eta, start, 1, (seed, 100_000), |e| {
+                        plane += (e.scatterings >= 2) as u64
+                    });
+                }
+                ball as f64 / plane as f64
+            })
+            .collect();
+        let incidence = |cos_i: f64| {
+            let k = cos_nodes.iter().position(|&x| x <= cos_i).unwrap_or(cos_nodes.len() - 1).max(1);
+            let w = (cos_nodes[k - 1] - cos_i) / (cos_nodes[k - 1] - cos_nodes[k]);
+            ((1.0 - w) * totals[k - 1] + w * totals[k]) / totals[0]
+        };
+        println!("{material} channel {c}: ball / half-space escapes at cos θi {cos_nodes:?}: {totals:.3?}");
+        let plain = rings(&m, &ratios[c], r_mm, |_| 1.0);
+        let inclined = rings(&m, &ratios[c], r_mm, incidence);
+        let mut line = format!("{material} channel {c}, model / walk (with the incidence weighting):");
+        for k in 0..RINGS {
+            line += &format!(" {}°: {:.3} ({:.3}) ±{:.1}%", 5 + 10 * k, plain[k].0, inclined[k].0, 100.0 * plain[k].1);
+        }
+        println!("{line}");
     }
 }
