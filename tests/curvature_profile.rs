@@ -324,6 +324,7 @@ fn the_front_lit_marble_sphere_matches_the_walk_ring_by_ring() {
 ///   within 5–10% out to 1.5R and falls to 0 at the antipode: with it the dark half gets darker;
 /// - the ball's radial ratio measured per angle of incidence (cos θi 1, 0.6, 0.2) is lower at
 ///   long chords for oblique beams: with it the dark half gets darker still (Skin1 red 0.70–0.77).
+///
 /// None of them is the cause; the pieces are exact for a normal beam, so what is missing is how an
 /// oblique beam's light is placed around a ball beyond the first harmonic.
 #[test]

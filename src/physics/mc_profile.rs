@@ -241,20 +241,19 @@ impl McProfile {
         let albedo = if sigma_t_reduced > 0.0 { sigma_s_reduced / sigma_t_reduced } else { 0.0 };
         let eta = m.eta;
         let cos_t_min = critical_cos_t(eta);
-        let mut density = vec![0.0; RADIAL_BINS + 1];
         let exit_bin = |e: &halfspace::Escape| ((e.mu_o2 * EXIT_BINS as f64) as usize).min(EXIT_BINS - 1);
-        // Per incidence node: photons traced, escapes per exit bin. The last node (normal
-        // incidence) also gives the radial profile.
-        let mut runs = [(0u64, [0u64; EXIT_BINS]); INCIDENCE_NODES];
-        // Per node and azimuth bin: Σ cos φ and the count of the exits of two or more scatterings.
-        let mut harmonic = [[(0.0f64, 0u64); AZIMUTH_BINS]; INCIDENCE_NODES];
-        let mut single = 0u64;
-        for (k, ((traced, exit_counts), cos_phi)) in runs.iter_mut().zip(harmonic.iter_mut()).enumerate() {
+        // Per incidence node: photons traced, escapes per exit bin, per azimuth bin Σ cos φ and
+        // the count of the exits of two or more scatterings; the last node (normal incidence)
+        // also gives the radial profile and the single scattering. Each node walks on its own
+        // thread, seeded by its index: the same bits on any machine.
+        let node = |k: usize| {
+            let (mut exit_counts, mut cos_phi) = ([0u64; EXIT_BINS], [(0.0f64, 0u64); AZIMUTH_BINS]);
+            let (mut density, mut single) = (vec![0.0; RADIAL_BINS + 1], 0u64);
             let cos_t = incidence_node(cos_t_min, k);
             let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
             let start = glam::DVec3::new(sin_t, 0.0, -cos_t);
             let seed = 0x5eed_0000_0000 + ((k as u64) << 32);
-            *traced = if k == INCIDENCE_NODES - 1 {
+            let traced = if k == INCIDENCE_NODES - 1 {
                 trace_until(
                     albedo,
                     eta,
@@ -291,7 +290,16 @@ impl McProfile {
                     },
                 )
             };
-        }
+            ((traced, exit_counts), cos_phi, density, single)
+        };
+        let node = &node;
+        let nodes: Vec<_> = std::thread::scope(|s| {
+            let handles: Vec<_> = (0..INCIDENCE_NODES).map(|k| s.spawn(move || node(k))).collect();
+            handles.into_iter().map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e))).collect()
+        });
+        let runs: [(u64, [u64; EXIT_BINS]); INCIDENCE_NODES] = std::array::from_fn(|k| nodes[k].0);
+        let harmonic: [[(f64, u64); AZIMUTH_BINS]; INCIDENCE_NODES] = std::array::from_fn(|k| nodes[k].1);
+        let (_, _, mut density, single) = nodes[INCIDENCE_NODES - 1].clone();
         let escape_of = |(traced, counts): &(u64, [u64; EXIT_BINS])| counts.iter().sum::<u64>() as f64 / *traced as f64;
         let (normal_traced, _) = runs[INCIDENCE_NODES - 1];
         for (k, d) in density.iter_mut().enumerate() {
