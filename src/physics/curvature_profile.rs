@@ -90,6 +90,31 @@ pub struct CurvatureChannel {
     pub concave_exit: Vec<[f64; EXIT_BINS]>,
 }
 
+impl super::table_cache::Flat for CurvatureChannel {
+    fn to_flat(&self) -> Vec<f64> {
+        let mut v = vec![self.unit_mm];
+        for rows in [&self.convex, &self.concave] {
+            super::table_cache::push_vec(&mut v, rows.iter().flatten().copied().collect::<Vec<_>>().into_iter());
+        }
+        for rows in [&self.convex_exit, &self.concave_exit] {
+            super::table_cache::push_vec(&mut v, rows.iter().flatten().copied().collect::<Vec<_>>().into_iter());
+        }
+        v
+    }
+    fn from_flat(values: &[f64]) -> Option<CurvatureChannel> {
+        let mut t = super::table_cache::Take(values);
+        let unit_mm = t.scalar()?;
+        fn rows<const N: usize>(flat: Vec<f64>) -> Option<Vec<[f64; N]>> {
+            (flat.len() == N * CURVATURE_NODES)
+                .then(|| flat.chunks_exact(N).filter_map(|c| c.try_into().ok()).collect())
+        }
+        let (convex, concave) = (rows::<ENTRIES>(t.vec()?)?, rows::<ENTRIES>(t.vec()?)?);
+        let (convex_exit, concave_exit) = (rows::<EXIT_BINS>(t.vec()?)?, rows::<EXIT_BINS>(t.vec()?)?);
+        t.end()?;
+        Some(CurvatureChannel { unit_mm, convex, concave, convex_exit, concave_exit })
+    }
+}
+
 /// The flat rows: a channel that carries nothing, or a material that does not.
 fn flat(unit_mm: f64) -> CurvatureChannel {
     CurvatureChannel {
@@ -142,7 +167,7 @@ fn of(m: &Medium, unit_mm: f64) -> Arc<CurvatureChannel> {
     if let Some(c) = cache.lock().unwrap_or_else(|e| e.into_inner()).get(&key) {
         return c.clone();
     }
-    let c = Arc::new(measure(m, unit_mm));
+    let c = Arc::new(super::table_cache::cached("curvature", &key, || measure(m, unit_mm)));
     cache.lock().unwrap_or_else(|e| e.into_inner()).insert(key, c.clone());
     c
 }

@@ -120,6 +120,49 @@ pub struct McProfile {
     pub azimuth: Vec<f64>,
 }
 
+impl super::table_cache::Flat for McProfile {
+    fn to_flat(&self) -> Vec<f64> {
+        let mut v = vec![
+            self.sigma_t_reduced,
+            self.albedo_reduced,
+            self.eta,
+            self.exit_norm,
+            self.escape,
+            self.single_escape,
+            self.cos_t_min,
+        ];
+        v.extend(self.incidence);
+        v.extend(self.exit.iter().flatten());
+        super::table_cache::push_vec(&mut v, self.density.iter().copied());
+        super::table_cache::push_vec(&mut v, self.azimuth.iter().copied());
+        v
+    }
+    fn from_flat(values: &[f64]) -> Option<McProfile> {
+        let mut t = super::table_cache::Take(values);
+        let [sigma_t_reduced, albedo_reduced, eta, exit_norm, escape, single_escape, cos_t_min] = t.array::<7>()?;
+        let incidence = t.array::<INCIDENCE_NODES>()?;
+        let mut exit = [[0.0; EXIT_BINS]; INCIDENCE_NODES];
+        for row in &mut exit {
+            *row = t.array::<EXIT_BINS>()?;
+        }
+        let (density, azimuth) = (t.vec()?, t.vec()?);
+        t.end()?;
+        Some(McProfile {
+            sigma_t_reduced,
+            albedo_reduced,
+            eta,
+            exit_norm,
+            escape,
+            single_escape,
+            density,
+            cos_t_min,
+            incidence,
+            exit,
+            azimuth,
+        })
+    }
+}
+
 /// The edges of radial bin `k` in mean free paths.
 fn bin_edges(k: usize) -> (f64, f64) {
     let q = (RHO_MAX / RHO_MIN).powf(1.0 / RADIAL_BINS as f64);
@@ -222,7 +265,7 @@ impl McProfile {
         if let Some(p) = cache.lock().unwrap_or_else(|e| e.into_inner()).get(&key) {
             return p.clone();
         }
-        let p = Arc::new(McProfile::measure(m));
+        let p = Arc::new(super::table_cache::cached("half-space", &key, || McProfile::measure(m)));
         cache.lock().unwrap_or_else(|e| e.into_inner()).insert(key, p.clone());
         p
     }

@@ -15,6 +15,7 @@ pub mod mc_profile;
 pub mod microfacet;
 pub mod slab_profile;
 pub mod sphere;
+pub mod table_cache;
 
 /// Which diffusion coefficient the directional dipole uses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]

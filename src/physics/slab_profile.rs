@@ -98,6 +98,35 @@ pub struct SlabChannel {
     pub exit: Vec<[f64; EXIT_BINS]>,
 }
 
+impl super::table_cache::Flat for SlabChannel {
+    fn to_flat(&self) -> Vec<f64> {
+        let mut v = vec![self.unit_mm];
+        v.extend(self.transmitted);
+        super::table_cache::push_vec(&mut v, self.sd.iter().flatten().copied().collect::<Vec<_>>().into_iter());
+        super::table_cache::push_vec(&mut v, self.lookup.iter().flatten().copied().collect::<Vec<_>>().into_iter());
+        super::table_cache::push_vec(&mut v, self.exit.iter().flatten().copied().collect::<Vec<_>>().into_iter());
+        v
+    }
+    fn from_flat(values: &[f64]) -> Option<SlabChannel> {
+        let mut t = super::table_cache::Take(values);
+        let unit_mm = t.scalar()?;
+        let transmitted = t.array::<THICKNESS_NODES>()?;
+        let rows = |flat: Vec<f64>| -> Option<Vec<[f64; ENTRIES]>> {
+            flat.len()
+                .is_multiple_of(ENTRIES)
+                .then(|| flat.chunks_exact(ENTRIES).filter_map(|c| c.try_into().ok()).collect())
+        };
+        let (sd, lookup) = (rows(t.vec()?)?, rows(t.vec()?)?);
+        let exit_flat = t.vec()?;
+        t.end()?;
+        if !exit_flat.len().is_multiple_of(EXIT_BINS) {
+            return None;
+        }
+        let exit = exit_flat.chunks_exact(EXIT_BINS).filter_map(|c| c.try_into().ok()).collect();
+        Some(SlabChannel { unit_mm, transmitted, sd, lookup, exit })
+    }
+}
+
 /// The reach of node `k`'s radial map (mm).
 fn reach_mm(unit_mm: f64, k: usize) -> f64 {
     unit_mm * (node_thickness(k) + 1.0)
@@ -121,7 +150,7 @@ impl SlabChannel {
         if let Some(p) = cache.lock().unwrap_or_else(|e| e.into_inner()).get(&key) {
             return p.clone();
         }
-        let p = Arc::new(SlabChannel::measure(m, unit_mm));
+        let p = Arc::new(super::table_cache::cached("slab", &key, || SlabChannel::measure(m, unit_mm)));
         cache.lock().unwrap_or_else(|e| e.into_inner()).insert(key, p.clone());
         p
     }
