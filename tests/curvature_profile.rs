@@ -53,7 +53,7 @@ fn a_ball_returns_more_a_cavity_less_and_flat_is_one() {
         let slight = ch.ratio(0.25 * unit, node_curvature(0) / unit);
         assert!((slight - 1.0).abs() < 0.1, "channel {c}: κL = 1/16 gives {slight}");
         // Monotone in κ at r = L/2 over the convex nodes whose diameter exceeds it (more
-        // curvature, more light kept; past 2R the ratio fades back to 1: no such chord on a ball).
+        // curvature, more light kept; past 4R the ratio fades back to 1: no such chord on a ball).
         let mut last = 1.0;
         for k in (0..CURVATURE_NODES).filter(|&k| node_curvature(k) <= 2.0) {
             let v = ch.ratio(0.5 * unit, node_curvature(k) / unit);

@@ -56,8 +56,9 @@ fn skin1_thin_slab_against_the_path_tracer() {
 /// The Monte Carlo table on the 10 mm Skin1 sphere, lit from the front and from behind: the
 /// curvature ratios and the oblique entry's harmonic (src/physics/curvature_profile.rs,
 /// mc_profile.rs) bring the front-lit one within 6% of the path tracer (measured 1.053 1.034
-/// 1.009), where the flat half-space's profile gave 0.88 0.90 0.93. Back-lit it is 0.898 0.847
-/// 0.788 (the half-space's 0.51 0.53 0.80): single scattering, now entering where refracted light
+/// 1.009), where the flat half-space's profile gave 0.88 0.90 0.93. Back-lit it is 0.917 0.852
+/// 0.788 (the half-space's 0.51 0.53 0.80; 0.898 0.847 0.788 before the curvature rows held
+/// their antipode's ratio past a ball's diameter): single scattering, now entering where refracted light
 /// really enters (shade.frag, light_entry), no longer lights the inside beyond the terminator,
 /// which had added 5 / 12 / 23% and hidden that much of a deficit of the multiple scattering
 /// (README, "Curved objects in the Monte Carlo table"); the test holds those ratios within 4%
@@ -67,7 +68,7 @@ fn skin1_thin_slab_against_the_path_tracer() {
 /// the silhouette the selection moves a back-lit mean by 4%).
 #[test]
 fn skin1_spheres_against_the_path_tracer() {
-    for (name, expected) in [("skin1/sphere-front", [1.0; 3]), ("skin1/sphere-back", [0.898, 0.847, 0.788])] {
+    for (name, expected) in [("skin1/sphere-front", [1.0; 3]), ("skin1/sphere-back", [0.917, 0.852, 0.788])] {
         let c = case(name);
         let options = c["render_options"].as_str().expect("render options");
         let tag = name.replace('/', "-");

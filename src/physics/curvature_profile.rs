@@ -19,9 +19,13 @@
 //! `curvature_ratio`) reads it at the pixel's mean curvature (the mesh's, smoothed over L:
 //! `mesh::smoothed_mean_curvature`), linear in κ from the flat row (1) to node 0 and linear in
 //! log κ between nodes, held beyond the last. A chord longer than a sphere's diameter 2R does not
-//! exist on it: there the ratio fades to 1 by 4R (the surface is no sphere there; the half-space
-//! is the safe guess). Where the sphere and half-space counted fewer than MIN_COUNT photons an
-//! entry holds the last entry that did.
+//! exist on it, but a row is read there all the same: a pixel's ball between two nodes is larger
+//! than the smaller node's, and its long chords read that row. So the row holds its antipode's
+//! ratio out to 4R (the next node's diameter) and only then fades to 1, by 8R (the surface is no
+//! sphere there; the half-space is the safe guess). Fading from 2R, as it once did, took half
+//! of the light a 10 mm Skin1 ball sends to its far side (the exact walk, tests/curvature_profile.rs:
+//! 0.84-0.88 of it in red past 145°, 0.94-0.96 now). Where the sphere and half-space counted fewer
+//! than MIN_COUNT photons an entry holds the last entry that did.
 //!
 //! The same walks give the exit's direction: a ball lets less light out at grazing angles and
 //! more near its normal than the half-space (looking back inside at a grazing exit, a chord of
@@ -293,7 +297,7 @@ fn exit_ratios(curved: &Counts, flat: &Counts, radius_mm: f64, unit_mm: f64) -> 
 
 /// The ratio per entry of `curved` (a sphere of signed radius `radius_mm`) to `flat` counts, held
 /// where either counted under MIN_COUNT (the first measured one before it, the last after), faded
-/// to 1 past a ball's diameter.
+/// to 1 from twice a ball's diameter.
 fn ratios(curved: &[u64; ENTRIES], flat: &[u64; ENTRIES], radius_mm: f64, unit_mm: f64) -> [f64; ENTRIES] {
     // Over three entries (weights 1 2 1) where the neighbours counted too: the walks' noise.
     let sum3 = |c: &[u64; ENTRIES], i: usize| {
@@ -316,8 +320,9 @@ fn ratios(curved: &[u64; ENTRIES], flat: &[u64; ENTRIES], radius_mm: f64, unit_m
         }
         let u = entry_centre(i);
         let r = unit_mm * u / (1.0 - u);
-        // Past 2R a ball has no such chord: back to the half-space by 4R.
-        let fade = if radius_mm > 0.0 { ((r - 2.0 * radius_mm) / (2.0 * radius_mm)).clamp(0.0, 1.0) } else { 0.0 };
+        // Past 2R a ball has no such chord, but a larger ball between this node and the next
+        // reads this row there: its antipode's ratio out to 4R, then back to the half-space by 8R.
+        let fade = if radius_mm > 0.0 { ((r - 4.0 * radius_mm) / (4.0 * radius_mm)).clamp(0.0, 1.0) } else { 0.0 };
         out[i] = held + (1.0 - held) * fade;
     }
     out
