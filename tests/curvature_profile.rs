@@ -124,6 +124,37 @@ fn the_azimuthal_harmonic_packs_and_leans_ahead() {
     }
 }
 
+/// Light along −z on a sphere of radius `r_mm` (centre (0, 0, −R) in mean free paths, the pole at
+/// the origin), walked exactly: photons on a stratified grid of `discs` × `angles` over the
+/// sphere's disc (equal areas: ring k's radius ∝ √((k + ½)/discs)), each entering refracted and
+/// weighted by its Fresnel transmittance; `on_escape(weight, escape)` for each escape. Returns the
+/// photons traced (each stands for πR²/photons of the disc).
+fn front_lit_walk(
+    m: &Medium,
+    r_mm: f64,
+    (discs, angles): (u64, u64),
+    mut on_escape: impl FnMut(f64, &sphere::SphereEscape),
+) -> u64 {
+    let sigma_t = m.sigma_a + m.sigma_s * (1.0 - m.g);
+    let (albedo, radius) = (m.sigma_s * (1.0 - m.g) / sigma_t, r_mm * sigma_t);
+    let centre = DVec3::new(0.0, 0.0, -radius);
+    let photons = discs * angles;
+    for i in 0..photons {
+        let (k, j) = (i / angles, i % angles);
+        let rho = radius * ((k as f64 + 0.5) / discs as f64).sqrt();
+        let phi = 2.0 * PI * (j as f64 + 0.5 * (k % 2) as f64) / angles as f64;
+        let p = DVec3::new(rho * phi.cos(), rho * phi.sin(), -radius + (radius * radius - rho * rho).max(0.0).sqrt());
+        let n = (p - centre) / radius;
+        let cos_i = n.z.clamp(0.0, 1.0);
+        let ft = fresnel::transmittance(m.eta, cos_i);
+        let cos_t = (1.0 - (1.0 - cos_i * cos_i) / (m.eta * m.eta)).max(0.0).sqrt();
+        let t = ((DVec3::new(0.0, 0.0, -1.0) + cos_i * n) / m.eta - cos_t * n).normalize();
+        let seed = 0x1234_5678 ^ i.wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        sphere::trace_from((albedo, m.eta, radius), p, t, (seed, 100_000), |e| on_escape(ft, e));
+    }
+    photons
+}
+
 /// A 10 mm Skin1 sphere under light along −z, by the walk: the exitance of two or more
 /// scatterings within 10° of the pole, against the renderer's sum over the lit hemisphere.
 #[test]
@@ -136,32 +167,14 @@ fn the_front_lit_sphere_at_its_pole_matches_the_walk() {
     for c in 0..3 {
         let m = media[c];
         let sigma_t = m.sigma_a + m.sigma_s * (1.0 - m.g);
-        let (albedo, radius) = (m.sigma_s * (1.0 - m.g) / sigma_t, r_mm * sigma_t);
-        let centre = DVec3::new(0.0, 0.0, -radius);
-        // Photons on a stratified grid over the sphere's disc (equal areas: ring k's radius
-        // ∝ √((k + ½)/rings)), each weighted by its Fresnel transmittance.
-        let (rings, angles) = (600u64, 1000u64);
-        let photons = rings * angles;
+        let radius = r_mm * sigma_t;
         let (mut count, mut weighted) = (0u64, 0.0f64);
-        for i in 0..photons {
-            let (k, j) = (i / angles, i % angles);
-            let rho = radius * ((k as f64 + 0.5) / rings as f64).sqrt();
-            let phi = 2.0 * PI * (j as f64 + 0.5 * (k % 2) as f64) / angles as f64;
-            let p =
-                DVec3::new(rho * phi.cos(), rho * phi.sin(), -radius + (radius * radius - rho * rho).max(0.0).sqrt());
-            let n = (p - centre) / radius;
-            let cos_i = n.z.clamp(0.0, 1.0);
-            let ft = fresnel::transmittance(m.eta, cos_i);
-            let cos_t = (1.0 - (1.0 - cos_i * cos_i) / (m.eta * m.eta)).max(0.0).sqrt();
-            let t = ((DVec3::new(0.0, 0.0, -1.0) + cos_i * n) / m.eta - cos_t * n).normalize();
-            let seed = 0x1234_5678 ^ i.wrapping_mul(0x9E37_79B9_7F4A_7C15);
-            sphere::trace_from((albedo, m.eta, radius), p, t, (seed, 100_000), |e| {
-                if e.scatterings >= 2 && e.geodesic / radius < cap {
-                    count += 1;
-                    weighted += ft;
-                }
-            });
-        }
+        let photons = front_lit_walk(&m, r_mm, (600, 1000), |ft, e| {
+            if e.scatterings >= 2 && e.geodesic / radius < cap {
+                count += 1;
+                weighted += ft;
+            }
+        });
         let truth = weighted * (PI * r_mm * r_mm / photons as f64) / cap_area;
         let noise = 1.0 / (count as f64).sqrt();
         // The renderer at the pole: Σ over the lit hemisphere of E cos θ Ft f(θt) Sp(r)
@@ -218,31 +231,15 @@ fn rings(
     harmonic: Option<&dyn Fn(f64) -> f64>,
 ) -> Vec<(f64, f64)> {
     let sigma_t = m.sigma_a + m.sigma_s * (1.0 - m.g);
-    let (albedo, radius) = (m.sigma_s * (1.0 - m.g) / sigma_t, r_mm * sigma_t);
-    let centre = DVec3::new(0.0, 0.0, -radius);
-    // Photons on a stratified grid over the disc (equal areas), weighted by Fresnel transmittance.
-    let (discs, angles) = (400u64, 800u64);
-    let photons = discs * angles;
+    let radius = r_mm * sigma_t;
     let (mut weighted, mut counts) = ([0.0f64; RINGS], [0u64; RINGS]);
-    for i in 0..photons {
-        let (k, j) = (i / angles, i % angles);
-        let rho = radius * ((k as f64 + 0.5) / discs as f64).sqrt();
-        let phi = 2.0 * PI * (j as f64 + 0.5 * (k % 2) as f64) / angles as f64;
-        let p = DVec3::new(rho * phi.cos(), rho * phi.sin(), -radius + (radius * radius - rho * rho).max(0.0).sqrt());
-        let n = (p - centre) / radius;
-        let cos_i = n.z.clamp(0.0, 1.0);
-        let ft = fresnel::transmittance(m.eta, cos_i);
-        let cos_t = (1.0 - (1.0 - cos_i * cos_i) / (m.eta * m.eta)).max(0.0).sqrt();
-        let t = ((DVec3::new(0.0, 0.0, -1.0) + cos_i * n) / m.eta - cos_t * n).normalize();
-        let seed = 0x1234_5678 ^ i.wrapping_mul(0x9E37_79B9_7F4A_7C15);
-        sphere::trace_from((albedo, m.eta, radius), p, t, (seed, 100_000), |e| {
-            let b = ((e.geodesic / radius) / PI * RINGS as f64) as usize;
-            if e.scatterings >= 2 && b < RINGS {
-                weighted[b] += ft;
-                counts[b] += 1;
-            }
-        });
-    }
+    let photons = front_lit_walk(m, r_mm, (400, 800), |ft, e| {
+        let b = ((e.geodesic / radius) / PI * RINGS as f64) as usize;
+        if e.scatterings >= 2 && b < RINGS {
+            weighted[b] += ft;
+            counts[b] += 1;
+        }
+    });
     let profile = McProfile::of(m);
     (0..RINGS)
         .map(|b| {
