@@ -306,7 +306,8 @@ fn the_front_lit_marble_sphere_matches_the_walk_ring_by_ring() {
     }
 }
 
-/// The same for any preset (`MATERIAL=potato`, default skin1), printed, with the corrections
+/// The same for any preset (`MATERIAL=potato`, default skin1) and radius (`RADIUS=3.67`, mm,
+/// default 5), printed, with the corrections
 /// that first-order reasoning suggests, each measured by the walks and tried in the sum. A
 /// diagnostic (issue #30): `MATERIAL=skin1 cargo test --release --test curvature_profile --
 /// --ignored --nocapture` (about 15 s). Measured (R / G / B; walk noise 0.5–2.5% on the lit half):
@@ -331,7 +332,7 @@ fn the_front_lit_sphere_ring_by_ring() {
     let m3 = Material::find(&material).expect("preset");
     let media = [0, 1, 2].map(|c| m3.channel(c));
     let ratios = curvature_profile::of_channels(&media);
-    let r_mm = 5.0;
+    let r_mm: f64 = std::env::var("RADIUS").ok().and_then(|v| v.parse().ok()).unwrap_or(5.0);
     for c in 0..3 {
         let m = media[c];
         let sigma_t = m.sigma_a + m.sigma_s * (1.0 - m.g);
