@@ -36,6 +36,32 @@ fn round_trip<T: Flat + PartialEq + std::fmt::Debug + Clone>(dir: &std::path::Pa
     assert_eq!(measured.get(), 2, "{kind}: another key measures");
 }
 
+/// A file of the same table measured by older code (another source hash) is replaced, not kept.
+#[test]
+fn older_files_of_a_table_are_replaced() {
+    let dir = scratch("replaced");
+    let table = (*McProfile::of(&ketchup()[0])).clone();
+    let _ = cached_in(Some(&dir), "half-space", &[9], || table.clone());
+    let names = || {
+        let mut v: Vec<String> = std::fs::read_dir(&dir)
+            .expect("cache dir")
+            .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    };
+    let current = names();
+    assert_eq!(current.len(), 1, "{current:?}");
+    // The same stem with another source hash, as an older build left it.
+    let stem = current[0].rsplit_once('-').expect("kind-key-source").0;
+    let older = dir.join(format!("{stem}-0123456789abcdef.f64"));
+    std::fs::write(&older, b"from an older build").expect("write");
+    std::fs::remove_file(dir.join(&current[0])).expect("remove");
+    let _ = cached_in(Some(&dir), "half-space", &[9], || table.clone());
+    assert_eq!(names(), current, "the older file is gone, the new one written");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn every_table_reads_back_the_same_bits() {
     let media = ketchup();

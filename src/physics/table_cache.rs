@@ -2,9 +2,10 @@
 //! slab's transmission and the curvature ratios take 2-20 s a material on two cores, every time
 //! `--model mc` starts, though they depend only on the material and on this code.
 //!
-//! Each table is written as its numbers (f64, little-endian) under a name hashed from its kind,
-//! its key (the medium's coefficients) and the source of every file that shapes the walk, so that
-//! a change to the physics misses the old files instead of reading them. A file that is missing,
+//! Each table is written as its numbers (f64, little-endian) under a name of its kind, a hash of
+//! its key (the medium's coefficients) and a hash of the source of every file that shapes the
+//! walk, so that a change to the physics misses the old file instead of reading it, and replaces
+//! it: the cache holds one file per table and material. A file that is missing,
 //! short, too long or fails its checksum is measured again and rewritten; a cache that cannot be
 //! written (read-only home, full disk) is skipped: the table is still measured, only not kept.
 //! Measurements are deterministic (fixed seeds), so a table read back is the same bits as the one
@@ -122,19 +123,32 @@ pub fn cached<T: Flat>(kind: &str, key: &[u64], measure: impl FnOnce() -> T) -> 
 /// [`cached`] in `dir` (None: measure, keep nothing).
 pub fn cached_in<T: Flat>(dir: Option<&Path>, kind: &str, key: &[u64], measure: impl FnOnce() -> T) -> T {
     let Some(dir) = dir else { return measure() };
-    let mut h = fnv(SOURCE_HASH, kind.as_bytes());
-    for k in key {
-        h = fnv(h, &k.to_le_bytes());
-    }
-    let path = dir.join(format!("{kind}-{h:016x}.f64"));
+    let key_hash = key.iter().fold(fnv(FNV_OFFSET, kind.as_bytes()), |h, k| fnv(h, &k.to_le_bytes()));
+    // One file per kind and key: measured by other code, it is replaced, not kept beside.
+    let stem = format!("{kind}-{key_hash:016x}-");
+    let path = dir.join(format!("{stem}{SOURCE_HASH:016x}.f64"));
     if let Some(table) = read(&path).and_then(|v| T::from_flat(&v)) {
         return table;
     }
     let table = measure();
-    if let Err(e) = write(dir, &path, &table.to_flat()) {
-        log::debug!("table cache: not kept ({}): {e}", path.display());
+    match write(dir, &path, &table.to_flat()) {
+        Ok(()) => remove_others(dir, &stem, &path),
+        Err(e) => log::debug!("table cache: not kept ({}): {e}", path.display()),
     }
     table
+}
+
+/// Removes the files of `stem` other than `keep` (the same table measured by older code).
+fn remove_others(dir: &Path, stem: &str, keep: &Path) {
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    for entry in entries.flatten() {
+        let path = entry.path();
+        let name = entry.file_name();
+        let name = name.to_string_lossy();
+        if path != keep && name.starts_with(stem) && name.ends_with(".f64") {
+            let _ = std::fs::remove_file(&path);
+        }
+    }
 }
 
 fn checksum(values: &[f64]) -> u64 {
