@@ -95,6 +95,12 @@ fn a_damaged_file_is_measured_again_and_an_unwritable_cache_is_skipped() {
         assert_eq!(cached_in(Some(&dir), "half-space", &[7], measure), table);
         assert_eq!(measured.get(), before + 1, "a damaged file is not read");
     }
+    // A file far longer than any table is refused and the table measured again (that it is
+    // refused before being read, the metadata check in `read`, no test here can see).
+    std::fs::write(&file, vec![0u8; 9 << 20]).expect("write");
+    let before = measured.get();
+    assert_eq!(cached_in(Some(&dir), "half-space", &[7], measure), table);
+    assert_eq!(measured.get(), before + 1, "an oversized file is not read");
     // The cache's directory is a file: nothing can be kept, the table is measured each time.
     let blocked = dir.join("a-file");
     std::fs::write(&blocked, b"x").expect("write");

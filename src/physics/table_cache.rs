@@ -156,6 +156,10 @@ fn checksum(values: &[f64]) -> u64 {
 }
 
 fn read(path: &Path) -> Option<Vec<f64>> {
+    // Not read at all when longer than any table: a stray large file costs no memory.
+    if std::fs::metadata(path).ok()?.len() > (8 * (MAX_VALUES + 3)) as u64 {
+        return None;
+    }
     let bytes = std::fs::read(path).ok()?;
     let body = bytes.strip_prefix(MAGIC)?;
     if body.len() < 16 || !body.len().is_multiple_of(8) || body.len() / 8 - 2 > MAX_VALUES {
