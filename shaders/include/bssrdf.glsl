@@ -166,12 +166,16 @@ vec3 slab_exit_factor(usamplerBuffer table, vec4 header, float t, float cos_o) {
 // u = r/(r + L), row j's texel holding per channel the ratios of nodes j − 1 (−1: flat, 1) and j
 // (κ_j L = 2^(j + first)) as two f16. `curvature_rows` (once per pixel): the row of κ (1/mm) and
 // the weight of its upper node, linear in κ from flat to node 0 and in log κ between nodes, held
-// past the last; w = L. `curvature_ratio` (per pair): one fetch, the nearest entry.
+// past the last; w = L (0 and x = −1: no ratios). `curvature_ratio` (per pair): one fetch, the nearest entry.
 const int CURVATURE_BASE = SLAB_BASE + 1 + int(SLAB_LOOKUP_NODES * SLAB_ENTRIES + SLAB_THICKNESS_NODES * MC_EXIT_BINS);
 const float CURVATURE_FIRST_LOG2 = float(CURVATURE_FIRST_LOG2_PLUS_8) - 8.0;
+vec4 curvature_rows_at(float unit_mm, float kappa);
 vec4 curvature_rows(usamplerBuffer table, float kappa) {
-    float unit_mm = uintBitsToFloat(texelFetch(table, CURVATURE_BASE).x);
-    if (!(unit_mm > 0.0)) return vec4(-1.0, 0.0, 0.0, 1.0);
+    return curvature_rows_at(uintBitsToFloat(texelFetch(table, CURVATURE_BASE).x), kappa);
+}
+// The same with L (texel CURVATURE_BASE, the rows' w) already read: per pair, no fetch.
+vec4 curvature_rows_at(float unit_mm, float kappa) {
+    if (!(unit_mm > 0.0)) return vec4(-1.0, 0.0, 0.0, 0.0);
     float x = abs(kappa) * unit_mm;
     if (!(x >= 0.0)) x = 0.0; // NaN: flat
     float side = kappa < 0.0 ? float(CURVATURE_NODES) : 0.0;

@@ -9,19 +9,32 @@
 #define SOURCES_GLSL
 vec4 dipole_header; // its texel 0, read once per pixel
 vec4 slab_header; // the Monte Carlo table's slab header (L in mm, scales), read once per pixel (0 for the other models)
-// The Monte Carlo table's curvature rows at the pixel's mean curvature (curvature_rows): every
-// pair of the pixel is read as on a sphere (or cavity) of the pixel's curvature, smoothed over
-// the longest diffusion length so that its sources' is nearly the same.
+// The Monte Carlo table's curvature rows at the pixel's mean curvature (curvature_rows), smoothed
+// over the longest diffusion length: the exit's distribution, the light across, and the near
+// field's tangent plane read it. Each source is read at its pair's own curvature (pair_curvature).
 vec4 pixel_curvature_rows;
 float pixel_curvature_mm = 0.0;
+
+// The curvature of the surface between a source (xi, ni) and the pixel (xo, no) along the way
+// from one to the other (mirrors physics::curvature_profile::pair_curvature): κ = (no − ni)·d/|d|²,
+// d = xo − xi in mm; on a sphere of radius R exactly 1/R for every pair, 0 between points of one
+// plane, negative in a cavity. The light between two points bends with the surface along their
+// way, not across it: a cylinder's exits around its bend are a ball's of its radius, along its
+// axis the half-space's (examples/cylinder_walk), so each pair is read as on the ball of its own
+// curvature. (The pixel's mean curvature read every pair of the pixel alike: a box's faces, flat,
+// lost the light that turns its edges, 0.53 of the path tracer in green.)
+float pair_curvature(vec3 d, vec3 ni, vec3 no) {
+    float r2 = dot(d, d);
+    return r2 > 0.0 ? dot(no - ni, d) / r2 : pixel_curvature_mm;
+}
 
 // The Monte Carlo table's multiple scattering at xo from a source at (xi, ni) lit from the mean
 // directions `toward[c]` (per channel, toward the lights, per unit power): Sp(r)·(1 + b(r) m·d̂),
 // the azimuthal harmonic of the light's lean, m = −(toward's part along the surface)/η the
 // refracted direction's part along it (|m| = sin θt for one light, shorter where lights
 // differ) and d̂ the direction to xo along xi's surface (so m·d̂ = −toward·d̂/η), times the
-// curvature ratio; r = |d|, d = xo − xi in mm.
-vec3 mc_sd(vec3 d, vec3 ni, vec3 toward[3]) {
+// curvature ratio at curvature `kappa` (1/mm); r = |d|, d = xo − xi in mm.
+vec3 mc_sd(vec3 d, vec3 ni, float kappa, vec3 toward[3]) {
     float r = length(d);
     vec3 tangential = d - dot(d, ni) * ni;
     float len = length(tangential);
@@ -29,7 +42,7 @@ vec3 mc_sd(vec3 d, vec3 ni, vec3 toward[3]) {
     vec3 lean = scale * vec3(dot(toward[0], tangential), dot(toward[1], tangential), dot(toward[2], tangential));
     vec3 b;
     vec3 sd = sd_table_azimuth(dipole_table, dipole_header, r, b);
-    return sd * max(vec3(1.0) + b * lean, vec3(0.0)) * curvature_ratio(dipole_table, pixel_curvature_rows, r);
+    return sd * max(vec3(1.0) + b * lean, vec3(0.0)) * curvature_ratio(dipole_table, curvature_rows_at(pixel_curvature_rows.w, kappa), r);
 }
 
 // Points nearer than this many diffusion lengths (1/σtr) of the farthest-reaching channel are
@@ -75,7 +88,8 @@ vec3 source(vec3 xi, vec3 ni, vec3 wi, vec3 power, vec3 xo, vec3 no) {
                   dirpole_channel_sd(object_params.channels[2], g, xi_mm, xo_mm, no));
     } else if (MODEL == MODEL_MC) {
         vec3 toward[3] = vec3[](wi, wi, wi);
-        sd = across(xi, ni, xo, no, mc_sd((xo - xi) * s, ni, toward), power * (s * s));
+        vec3 d = (xo - xi) * s;
+        sd = across(xi, ni, xo, no, mc_sd(d, ni, pair_curvature(d, ni, no), toward), power * (s * s));
     } else {
         sd = dipole_sd_table(dipole_table, dipole_header, length(xo - xi) * s);
     }
@@ -107,7 +121,10 @@ vec3 merged_source(vec3 xi, vec3 ni, vec3 power, vec4 incident[3], vec3 dw, vec3
         // Each channel's mean direction toward its lights: Σ E ωi / Σ E (the merged record's).
         vec3 toward[3];
         for (uint c = 0u; c < 3u; ++c) toward[c] = power[c] > 0.0 ? incident[c].xyz / power[c] : vec3(0.0);
-        sd = mc_sd((xo - xi) * s, ni, toward);
+        // A source of the object at its pair's curvature; the near field's tangent plane
+        // (across_object false) stands for the surface around the pixel, at the pixel's.
+        vec3 d = (xo - xi) * s;
+        sd = mc_sd(d, ni, across_object ? pair_curvature(d, ni, no) : pixel_curvature_mm, toward);
         if (across_object) sd = across(xi, ni, xo, no, sd, power * (s * s));
     } else {
         sd = dipole_sd_table(dipole_table, dipole_header, length(xo - xi) * s);
@@ -179,6 +196,6 @@ void begin_sources(vec4 normal_curvature) {
     slab_header = MODEL == MODEL_MC ? slab_header_of(dipole_table) : vec4(0.0);
     if (MODEL == MODEL_MC) pixel_curvature_mm = normal_curvature.w / object_params.mm_per_unit;
     pixel_curvature_rows = MODEL == MODEL_MC ? curvature_rows(dipole_table, pixel_curvature_mm)
-                                             : vec4(-1.0, 0.0, 0.0, 1.0);
+                                             : vec4(-1.0, 0.0, 0.0, 0.0);
 }
 #endif

@@ -1,5 +1,7 @@
-//! A mesh's mean curvature per vertex, smoothed over a length: what the Monte Carlo table's
-//! curvature ratios (physics::curvature_profile) are read at, per pixel, through the surface pass.
+//! A mesh's mean curvature per vertex, smoothed over a length: the pixel's curvature, through the
+//! surface pass, at which the Monte Carlo table's exit direction and light across read the
+//! curvature ratios (physics::curvature_profile); each source's ratio is read at its pair's own
+//! curvature (`curvature_profile::pair_curvature`).
 
 use std::collections::HashMap;
 

@@ -16,9 +16,10 @@
 //! κ_k = 2^(k + FIRST_CURVATURE_LOG2) / L, k = 0 … CURVATURE_NODES − 1 (1/16 … 8 of κL: radii 16 L
 //! down to L/8), each sign, L the longest diffusion length 1/σtr of the material's channels (the
 //! Sd table's reach); entries equally spaced in u = r/(r + L). The shade pass (bssrdf.glsl
-//! `curvature_ratio`) reads it at the pixel's mean curvature (the mesh's, smoothed over L:
-//! `mesh::smoothed_mean_curvature`), linear in κ from the flat row (1) to node 0 and linear in
-//! log κ between nodes, held beyond the last. A chord longer than a sphere's diameter 2R does not
+//! `curvature_ratio`) reads it per source at the pair's own curvature along the way between them
+//! ([`pair_curvature`]; the exit's distribution and the light across at the pixel's mean
+//! curvature, the mesh's smoothed over L: `mesh::smoothed_mean_curvature`), linear in κ from the
+//! flat row (1) to node 0 and linear in log κ between nodes, held beyond the last. A chord longer than a sphere's diameter 2R does not
 //! exist on it, but a row is read there all the same: a pixel's ball between two nodes is larger
 //! than the smaller node's, and its long chords read that row. So the row holds its antipode's
 //! ratio out to 4R (the next node's diameter) and only then fades to 1, by 8R (the surface is no
@@ -74,6 +75,21 @@ pub fn nodes_at(kappa_l: f64) -> (Option<usize>, usize, f64) {
     let k = (x.log2() - FIRST_CURVATURE_LOG2 as f64).min((CURVATURE_NODES - 1) as f64);
     let i = (k.floor() as usize).min(CURVATURE_NODES - 2);
     (Some(i), i + 1, k - i as f64)
+}
+
+/// The curvature of the surface between a source (position, normal `ni`) and an exit (normal
+/// `no`) along the way from one to the other, `d` the exit's position less the source's:
+/// κ = (no − ni)·d/|d|² (1/length of d; `None` where d = 0). The shade pass reads each pair's
+/// ratio at it (sources.glsl `pair_curvature`, which this mirrors). On a sphere of radius R it is
+/// exactly 1/R for every pair (no − ni = d/R), between points of one plane 0, in a spherical
+/// cavity −1/R; on a cylinder c²/(R(c² + a²)) for a chord c around it and a along its axis (the
+/// normal curvature cos²ψ/R of the chord's direction, Euler's). Light between two points bends
+/// with the surface along their way: a cylinder's exits around its bend are the ball's of its
+/// radius at the same chord and along its axis the half-space's (`cargo run --release --example
+/// cylinder_walk`), so a pair is read as on the ball of its own curvature, not the pixel's mean.
+pub fn pair_curvature(d: DVec3, ni: DVec3, no: DVec3) -> Option<f64> {
+    let r2 = d.length_squared();
+    (r2 > 0.0).then(|| (no - ni).dot(d) / r2)
 }
 
 /// The centre of entry `i` in u.
