@@ -82,7 +82,7 @@ impl Shape {
 }
 
 /// Exits of ≥ 2 scatterings: (exit point) per photon.
-fn walk(shape: Shape, albedo: f64, eta: f64, photons: u64, seed: u64, mut tally: impl FnMut(DVec3)) {
+fn walk(shape: Shape, albedo: f64, eta: f64, photons: u64, seed: u64, mut tally: impl FnMut(DVec3, f64)) {
     let mut rng = Rng(seed);
     for _ in 0..photons {
         let (mut p, mut d) = (DVec3::ZERO, DVec3::NEG_Z);
@@ -98,7 +98,7 @@ fn walk(shape: Shape, albedo: f64, eta: f64, photons: u64, seed: u64, mut tally:
                     continue;
                 }
                 if scatterings >= 2 {
-                    tally(p);
+                    tally(p, (1.0 - eta * eta * (1.0 - cos * cos)).max(0.0));
                 }
                 break;
             }
@@ -130,7 +130,7 @@ fn wedge(material: &str, a_mm: f64, photons: u64) {
         let w = 0.25;
         let hs: Vec<f64> = (0..12).map(|k| 0.25 * 2f64.powf(k as f64 / 2.0)).collect();
         let mut front = vec![0.0f64; hs.len() - 1];
-        walk(Shape::Wedge(a), albedo, m.eta, photons, 7, |p| {
+        walk(Shape::Wedge(a), albedo, m.eta, photons, 7, |p, _| {
             if p.y.abs() < w && (p.x - a).abs() < 1e-9 {
                 if let Some(k) = hs.iter().rposition(|&e| e <= -p.z).filter(|&k| k < hs.len() - 1) {
                     front[k] += 1.0;
@@ -139,7 +139,7 @@ fn wedge(material: &str, a_mm: f64, photons: u64) {
         });
         let pe: Vec<f64> = (0..64).map(|k| 0.05 * 2f64.powf(k as f64 / 6.0)).collect();
         let mut plane = vec![0.0f64; pe.len()];
-        walk(Shape::Plane, albedo, m.eta, photons * 4, 7, |p| {
+        walk(Shape::Plane, albedo, m.eta, photons * 4, 7, |p, _| {
             let r = (p.x * p.x + p.y * p.y).sqrt();
             if let Some(k) = pe.iter().rposition(|&e| e <= r).filter(|&k| k < pe.len() - 1) {
                 plane[k] += 1.0;
@@ -170,7 +170,41 @@ fn wedge(material: &str, a_mm: f64, photons: u64) {
     }
 }
 
+/// The exit's distribution over cos²θo (outside) of a ball's multiple-scattering escapes, near
+/// the entry (chord < R√2) and on the far side, against the half-space's.
+fn exits(material: &str, r_mm: f64, photons: u64) {
+    let m3 = Material::find(material).expect("preset");
+    for c in 0..3 {
+        let m = m3.channel(c);
+        let sigma_t = m.sigma_a + m.sigma_s * (1.0 - m.g);
+        let albedo = m.sigma_s * (1.0 - m.g) / sigma_t;
+        let r = r_mm * sigma_t;
+        let mut bins = [[0.0f64; 10]; 5];
+        walk(Shape::Ball(r), albedo, m.eta, photons, 3, |p, mu2| {
+            let b = ((mu2 * 10.0) as usize).min(9);
+            let angle = (p.z + r).atan2((p.x * p.x + p.y * p.y).sqrt());
+            let polar = std::f64::consts::FRAC_PI_2 - angle; // from the entry's axis
+            let group = if p.length() < r * std::f64::consts::SQRT_2 { 0 } else if polar < 2.0 * PI / 3.0 { 1 } else if polar < 5.0 * PI / 6.0 { 2 } else { 3 };
+            bins[group][b] += 1.0;
+        });
+        walk(Shape::Plane, albedo, m.eta, photons, 3, |_, mu2| bins[4][((mu2 * 10.0) as usize).min(9)] += 1.0);
+        println!("{material} channel {c}, R = {r_mm} mm: the exit's distribution over cos²θo bins, each normalised (per bin / the half-space's)");
+        let names = ["near (chord < R√2)", "90-120°", "120-150°", "150-180°"];
+        for g in 0..4 {
+            let n: f64 = bins[g].iter().sum();
+            let n4: f64 = bins[4].iter().sum();
+            let v: Vec<String> = (0..10).map(|b| format!("{:.2}", (bins[g][b] / n) / (bins[4][b] / n4))).collect();
+            println!("  {:20} (n = {n:8.0}) {}", names[g], v.join(" "));
+        }
+    }
+}
+
 fn main() {
+    if std::env::args().nth(1).as_deref() == Some("exits") {
+        let r: f64 = std::env::args().nth(3).and_then(|v| v.parse().ok()).unwrap_or(5.0);
+        exits(&std::env::args().nth(2).unwrap_or_else(|| "skin1".into()), r, 1_000_000);
+        return;
+    }
     if std::env::args().nth(1).as_deref() == Some("wedge") {
         let a: f64 = std::env::args().nth(3).and_then(|v| v.parse().ok()).unwrap_or(1.0);
         wedge(&std::env::args().nth(2).unwrap_or_else(|| "skin1".into()), a, 2_000_000);
@@ -218,7 +252,7 @@ fn main() {
             }
         }
         let mut cyl = vec![[0.0f64; 2]; nb];
-        walk(Shape::Cylinder(r), albedo, m.eta, photons, 1, |p| {
+        walk(Shape::Cylinder(r), albedo, m.eta, photons, 1, |p, _| {
             if let (Some(b), Some(s)) = (bin(p.length()), sector(p)) {
                 cyl[b][s] += 1.0;
             }
@@ -226,7 +260,7 @@ fn main() {
         // Balls and the plane: per unit area by chord (area of a ball between chords a, b: π(b² − a²), exactly).
         let per_area = |shape: Shape| -> Vec<f64> {
             let mut n = vec![0.0f64; nb];
-            walk(shape, albedo, m.eta, photons, 1, |p| {
+            walk(shape, albedo, m.eta, photons, 1, |p, _| {
                 if let Some(b) = bin(p.length()) {
                     n[b] += 1.0;
                 }

@@ -82,5 +82,6 @@ void main() {
                  + merged_source(center - offset, ni, power, incident, vec3(0.0), xo, no, true);
         }
     }
-    far_field[tile * FAR_FIELD_SAMPLES + sample_index] = vec4(sum, 0.0);
+    // w: the luminance of the part from beyond a chord R√2 (far_light, the exit's rows).
+    far_field[tile * FAR_FIELD_SAMPLES + sample_index] = vec4(sum, far_light.x);
 }

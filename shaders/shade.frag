@@ -625,7 +625,9 @@ void main() {
             ivec2 at = pixel % int(FAR_FIELD_TILE);
             vec4 wu = far_weights(float(at.x)), wv = far_weights(float(at.y));
             for (uint k = 0u; k < FAR_FIELD_SAMPLES; ++k) {
-                sum += (wu[k % 4u] * wv[k / 4u]) * texel_float(far_field, tile_index * FAR_FIELD_SAMPLES + k).xyz;
+                vec4 far = (wu[k % 4u] * wv[k / 4u]) * texel_float(far_field, tile_index * FAR_FIELD_SAMPLES + k);
+                sum += far.xyz;
+                far_light += vec2(far.w, dot(far.xyz, vec3(0.2126, 0.7152, 0.0722)));
             }
         }
 
@@ -770,7 +772,9 @@ void main() {
         if (!NEAR_FIELD) own_light(xo, no);
         // On a curved surface the exit's distribution is the ball's (curvature_exit: less
         // grazing light leaves a ball than a half-space).
-        lo *= table_exit_factor(dipole_table, own_cos_t(), cos_o) * curvature_exit(dipole_table, pixel_curvature_rows, cos_o);
+        // and light from a ball's far side leaves it nearer the normal (far_light).
+        float far = far_light.y > 0.0 ? clamp(far_light.x / far_light.y, 0.0, 1.0) : 0.0;
+        lo *= table_exit_factor(dipole_table, own_cos_t(), cos_o) * curvature_exit(dipole_table, pixel_curvature_rows, cos_o, far);
         if (across_thickness.y > 0.0) {
             float t = across_thickness.x / across_thickness.y;
             lo += fresnel_transmittance(object_params.channels[0].eta, cos_o) * across_sum

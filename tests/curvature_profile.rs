@@ -86,12 +86,19 @@ fn a_ball_returns_more_a_cavity_less_and_flat_is_one() {
         // chord R√2, normalised), in the red and green, which diffuse furthest (the blue's R is
         // 5.5 of its mean free paths: nearly flat to it).
         for cos_o in [0.1, 0.5, 1.0] {
-            assert_eq!(ch.exit_ratio(cos_o, 0.0), 1.0);
+            assert_eq!(ch.exit_ratio(cos_o, 0.0, 0.0), 1.0);
+            assert_eq!(ch.exit_ratio(cos_o, 0.0, 1.0), 1.0);
         }
-        let (grazing, normal) = (ch.exit_ratio(0.2, 1.0 / unit), ch.exit_ratio(1.0, 1.0 / unit));
+        let (grazing, normal) = (ch.exit_ratio(0.2, 1.0 / unit, 0.0), ch.exit_ratio(1.0, 1.0 / unit, 0.0));
         println!("channel {c}: exit ratio at κL = 1, cos θo 0.2 / 1: {grazing:.3} / {normal:.3}");
         if c < 2 {
             assert!(grazing < 1.0 && normal > 1.0 && normal - grazing > 0.05, "channel {c}: {grazing} / {normal}");
+        }
+        // The light from the far side of the ball leaves still nearer the normal.
+        let (far_grazing, far_normal) = (ch.exit_ratio(0.2, 1.0 / unit, 1.0), ch.exit_ratio(1.0, 1.0 / unit, 1.0));
+        println!("channel {c}: the far light's at κL = 1, cos θo 0.2 / 1: {far_grazing:.3} / {far_normal:.3}");
+        if c < 2 {
+            assert!(far_grazing < grazing && far_normal > normal, "channel {c}: {far_grazing} / {far_normal}");
         }
         // The smallest curvature changes little near the entry.
         let slight = ch.ratio(0.25 * unit, node_curvature(0) / unit);
@@ -137,15 +144,18 @@ fn the_gpu_table_reads_the_ratios() {
     let mut worst_exit = 0.0f64;
     for kappa_l in [0.03, 0.2, 0.73, 1.5, 3.0, -0.3, -1.2] {
         for cos_o in [0.0, 0.1, 0.35, 0.7, 0.9, 1.0] {
-            let gpu = table.lookup_exit(cos_o, kappa_l / unit);
-            for c in 0..3 {
-                worst_exit = worst_exit.max((gpu[c] / channels[c].exit_ratio(cos_o, kappa_l / unit) - 1.0).abs());
+            for far in [0.0, 0.3, 1.0] {
+                let gpu = table.lookup_exit(cos_o, kappa_l / unit, far);
+                for c in 0..3 {
+                    let exact = channels[c].exit_ratio(cos_o, kappa_l / unit, far);
+                    worst_exit = worst_exit.max((gpu[c] / exact - 1.0).abs());
+                }
             }
         }
     }
     println!("exit rows: worst relative difference {worst_exit:.5}");
     assert!(worst_exit < 2e-3, "{worst_exit}");
-    assert_eq!(CurvatureRatios::none().lookup_exit(0.3, 0.5), [1.0; 3]);
+    assert_eq!(CurvatureRatios::none().lookup_exit(0.3, 0.5, 0.5), [1.0; 3]);
 }
 
 #[test]

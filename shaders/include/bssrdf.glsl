@@ -196,19 +196,21 @@ vec3 curvature_ratio(usamplerBuffer table, vec4 rows, float r_mm) {
 // The exit distribution's curvature ratio (mirrors gpu::sd_table::CurvatureRatios::lookup_exit,
 // physics::curvature_profile::CurvatureChannel::exit_ratio), multiplying the exit factor h: after
 // the ratio rows, per side the same pairing of nodes in rows of MC_EXIT_BINS texels; linear in
-// cos²θo between the bins' centres, held beyond the outer ones. `rows` from curvature_rows.
-vec3 curvature_exit(usamplerBuffer table, vec4 rows, float cos_o) {
+// cos²θo between the bins' centres, held beyond the outer ones. `rows` from curvature_rows. Then
+// the same rows of the light from beyond a chord R√2, mixed in by `far` (its share).
+vec3 curvature_exit(usamplerBuffer table, vec4 rows, float cos_o, float far) {
     if (rows.x < 0.0) return vec3(1.0);
     int base = CURVATURE_BASE + 1 + 2 * int(CURVATURE_NODES * CURVATURE_TABLE_ENTRIES) + int(rows.x) * int(MC_EXIT_BINS);
     float y = clamp(cos_o * cos_o * float(MC_EXIT_BINS) - 0.5, 0.0, float(MC_EXIT_BINS - 1u));
     float j = min(floor(y), float(MC_EXIT_BINS - 2u));
-    vec3 at[2];
-    for (int k = 0; k < 2; ++k) {
-        uvec3 pairs = texelFetch(table, base + int(j) + k).xyz;
+    vec3 at[4];
+    for (int k = 0; k < 4; ++k) {
+        int far_rows = (k / 2) * 2 * int(CURVATURE_NODES * MC_EXIT_BINS);
+        uvec3 pairs = texelFetch(table, base + far_rows + int(j) + k % 2).xyz;
         vec2 red = unpackHalf2x16(pairs.x), green = unpackHalf2x16(pairs.y), blue = unpackHalf2x16(pairs.z);
         at[k] = mix(vec3(red.x, green.x, blue.x), vec3(red.y, green.y, blue.y), rows.y);
     }
-    return mix(at[0], at[1], y - j);
+    return mix(mix(at[0], at[1], y - j), mix(at[2], at[3], y - j), far);
 }
 
 // The ray-source term S'(x, w, r) of the directional dipole.

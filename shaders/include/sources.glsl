@@ -23,6 +23,15 @@ float pixel_curvature_mm = 0.0;
 // axis the half-space's (examples/cylinder_walk), so each pair is read as on the ball of its own
 // curvature. (The pixel's mean curvature read every pair of the pixel alike: a box's faces, flat,
 // lost the light that turns its edges, 0.53 of the path tracer in green.)
+// The light of the object's sources, by luminance: x from beyond a chord R√2 of the pair's ball
+// (rκ ≥ √2: the far hemisphere of a ball, none on a plane), y all of it. It leaves nearer the
+// normal (curvature_exit's far rows), weighed by x/y per pixel.
+vec2 far_light = vec2(0.0);
+void count_far(float r_kappa, vec3 contribution) {
+    float luminance = dot(contribution, vec3(0.2126, 0.7152, 0.0722));
+    far_light += vec2(r_kappa >= 1.41421356 ? luminance : 0.0, luminance);
+}
+
 float pair_curvature(vec3 d, vec3 ni, vec3 no) {
     float r2 = dot(d, d);
     return r2 > 0.0 ? dot(no - ni, d) / r2 : pixel_curvature_mm;
@@ -89,7 +98,9 @@ vec3 source(vec3 xi, vec3 ni, vec3 wi, vec3 power, vec3 xo, vec3 no) {
     } else if (MODEL == MODEL_MC) {
         vec3 toward[3] = vec3[](wi, wi, wi);
         vec3 d = (xo - xi) * s;
-        sd = across(xi, ni, xo, no, mc_sd(d, ni, pair_curvature(d, ni, no), toward), power * (s * s));
+        float kappa = pair_curvature(d, ni, no);
+        sd = across(xi, ni, xo, no, mc_sd(d, ni, kappa, toward), power * (s * s));
+        count_far(length(d) * kappa, sd * power * (s * s));
     } else {
         sd = dipole_sd_table(dipole_table, dipole_header, length(xo - xi) * s);
     }
@@ -124,8 +135,12 @@ vec3 merged_source(vec3 xi, vec3 ni, vec3 power, vec4 incident[3], vec3 dw, vec3
         // A source of the object at its pair's curvature; the near field's tangent plane
         // (across_object false) stands for the surface around the pixel, at the pixel's.
         vec3 d = (xo - xi) * s;
-        sd = mc_sd(d, ni, across_object ? pair_curvature(d, ni, no) : pixel_curvature_mm, toward);
-        if (across_object) sd = across(xi, ni, xo, no, sd, power * (s * s));
+        float kappa = across_object ? pair_curvature(d, ni, no) : pixel_curvature_mm;
+        sd = mc_sd(d, ni, kappa, toward);
+        if (across_object) {
+            sd = across(xi, ni, xo, no, sd, power * (s * s));
+            count_far(length(d) * kappa, sd * power * (s * s));
+        }
     } else {
         sd = dipole_sd_table(dipole_table, dipole_header, length(xo - xi) * s);
     }

@@ -311,7 +311,8 @@ pub const CURVATURE_TABLE_ENTRIES: usize = super::CURVATURE_TABLE_ENTRIES as usi
 /// two neighbouring curvature nodes' ratios as two f16, so that one fetch interpolates in κ: on
 /// each side (convex, then concave) row j holds nodes j − 1 and j, node −1 being the flat
 /// surface (every ratio 1). Then the exit distribution's ratios (`curvature_exit`;
-/// [`CurvatureChannel::exit_ratio`]): the same 2N rows of MC_EXIT_BINS texels, paired the same way.
+/// [`CurvatureChannel::exit_ratio`]): the same 2N rows of MC_EXIT_BINS texels, paired the same way,
+/// of the light from within a chord R√2, then 2N more of the light from beyond it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CurvatureRatios {
     pub unit_mm: f32,
@@ -321,6 +322,8 @@ pub struct CurvatureRatios {
     /// Per side, per node, per exit bin, per channel.
     pub convex_exit: Vec<Vec<[f32; 3]>>,
     pub concave_exit: Vec<Vec<[f32; 3]>>,
+    pub convex_exit_far: Vec<Vec<[f32; 3]>>,
+    pub concave_exit_far: Vec<Vec<[f32; 3]>>,
 }
 
 impl CurvatureRatios {
@@ -335,7 +338,9 @@ impl CurvatureRatios {
             convex: flat.clone(),
             concave: flat,
             convex_exit: flat_exit.clone(),
-            concave_exit: flat_exit,
+            concave_exit: flat_exit.clone(),
+            convex_exit_far: flat_exit.clone(),
+            concave_exit_far: flat_exit,
         }
     }
 
@@ -354,13 +359,19 @@ impl CurvatureRatios {
                 })
                 .collect()
         };
-        let exits = |concave: bool| -> Vec<Vec<[f32; 3]>> {
+        let exits = |concave: bool, far: bool| -> Vec<Vec<[f32; 3]>> {
             (0..curvature_profile::CURVATURE_NODES)
                 .map(|k| {
                     (0..mc_profile::EXIT_BINS)
                         .map(|b| {
                             [0, 1, 2].map(|c| {
-                                let rows = if concave { &channels[c].concave_exit } else { &channels[c].convex_exit };
+                                let ch = &channels[c];
+                                let rows = match (concave, far) {
+                                    (false, false) => &ch.convex_exit,
+                                    (true, false) => &ch.concave_exit,
+                                    (false, true) => &ch.convex_exit_far,
+                                    (true, true) => &ch.concave_exit_far,
+                                };
                                 rows[k][b] as f32
                             })
                         })
@@ -375,8 +386,10 @@ impl CurvatureRatios {
             unit_mm: unit as f32,
             convex: nodes(1.0),
             concave: nodes(-1.0),
-            convex_exit: exits(false),
-            concave_exit: exits(true),
+            convex_exit: exits(false, false),
+            concave_exit: exits(true, false),
+            convex_exit_far: exits(false, true),
+            concave_exit_far: exits(true, true),
         }
     }
 
@@ -403,23 +416,34 @@ impl CurvatureRatios {
             .chain(side(&self.concave, CURVATURE_TABLE_ENTRIES))
             .chain(side(&self.convex_exit, mc_profile::EXIT_BINS))
             .chain(side(&self.concave_exit, mc_profile::EXIT_BINS))
+            .chain(side(&self.convex_exit_far, mc_profile::EXIT_BINS))
+            .chain(side(&self.concave_exit_far, mc_profile::EXIT_BINS))
             .collect()
     }
 
     /// The exit distribution's ratio per channel at exit cosine `cos_o` and curvature `kappa`
     /// (1/mm), as the shade pass reads it (`curvature_exit`): linear in cos²θo between bin
-    /// centres (held beyond the outer ones), in κ as [`CurvatureRatios::lookup`].
-    pub fn lookup_exit(&self, cos_o: f64, kappa: f64) -> [f64; 3] {
+    /// centres (held beyond the outer ones), in κ as [`CurvatureRatios::lookup`], the rows of
+    /// near and far light mixed by `far` (the share of the light from beyond a chord R√2).
+    pub fn lookup_exit(&self, cos_o: f64, kappa: f64, far: f64) -> [f64; 3] {
         let unit = self.unit_mm as f64;
         if unit.is_nan() || unit <= 0.0 {
             return [1.0; 3];
         }
-        let nodes = if kappa < 0.0 { &self.concave_exit } else { &self.convex_exit };
+        let (near_nodes, far_nodes) = if kappa < 0.0 {
+            (&self.concave_exit, &self.concave_exit_far)
+        } else {
+            (&self.convex_exit, &self.convex_exit_far)
+        };
         let y = (cos_o * cos_o * mc_profile::EXIT_BINS as f64 - 0.5).clamp(0.0, (mc_profile::EXIT_BINS - 1) as f64);
         let j = (y.floor() as usize).min(mc_profile::EXIT_BINS - 2);
         [0, 1, 2].map(|c| {
-            let at = |b: usize| self.between_nodes(nodes, kappa, b, c);
-            at(j) + (at(j + 1) - at(j)) * (y - j as f64)
+            let read = |nodes: &[Vec<[f32; 3]>]| {
+                let at = |b: usize| self.between_nodes(nodes, kappa, b, c);
+                at(j) + (at(j + 1) - at(j)) * (y - j as f64)
+            };
+            let (near, beyond) = (read(near_nodes), read(far_nodes));
+            near + (beyond - near) * far
         })
     }
 
@@ -446,7 +470,7 @@ impl CurvatureRatios {
     }
 
     /// Texels after the light across.
-    pub const TEXELS: usize = 1 + Self::ROWS * (CURVATURE_TABLE_ENTRIES + mc_profile::EXIT_BINS);
+    pub const TEXELS: usize = 1 + Self::ROWS * (CURVATURE_TABLE_ENTRIES + 2 * mc_profile::EXIT_BINS);
 }
 
 /// Beam diffusion's entry at `r` of a table of `reach`: Sd, but at r = 0 the v0 for which the

@@ -105,9 +105,13 @@ pub struct CurvatureChannel {
     /// Per node (convex, then concave), per entry.
     pub convex: Vec<[f64; ENTRIES]>,
     pub concave: Vec<[f64; ENTRIES]>,
-    /// Per node, per exit bin (the Monte Carlo table's, in cos²θo): the exit distribution's ratio.
+    /// Per node, per exit bin (the Monte Carlo table's, in cos²θo): the exit distribution's ratio
+    /// of the light that leaves within a chord R√2 of where it entered.
     pub convex_exit: Vec<[f64; EXIT_BINS]>,
     pub concave_exit: Vec<[f64; EXIT_BINS]>,
+    /// The same of the light that leaves farther (a ball's far hemisphere): nearer the normal.
+    pub convex_exit_far: Vec<[f64; EXIT_BINS]>,
+    pub concave_exit_far: Vec<[f64; EXIT_BINS]>,
 }
 
 impl super::table_cache::Flat for CurvatureChannel {
@@ -116,7 +120,7 @@ impl super::table_cache::Flat for CurvatureChannel {
         for rows in [&self.convex, &self.concave] {
             super::table_cache::push_vec(&mut v, rows.iter().flatten().copied().collect::<Vec<_>>().into_iter());
         }
-        for rows in [&self.convex_exit, &self.concave_exit] {
+        for rows in [&self.convex_exit, &self.concave_exit, &self.convex_exit_far, &self.concave_exit_far] {
             super::table_cache::push_vec(&mut v, rows.iter().flatten().copied().collect::<Vec<_>>().into_iter());
         }
         v
@@ -130,8 +134,9 @@ impl super::table_cache::Flat for CurvatureChannel {
         }
         let (convex, concave) = (rows::<ENTRIES>(t.vec()?)?, rows::<ENTRIES>(t.vec()?)?);
         let (convex_exit, concave_exit) = (rows::<EXIT_BINS>(t.vec()?)?, rows::<EXIT_BINS>(t.vec()?)?);
+        let (convex_exit_far, concave_exit_far) = (rows::<EXIT_BINS>(t.vec()?)?, rows::<EXIT_BINS>(t.vec()?)?);
         t.end()?;
-        Some(CurvatureChannel { unit_mm, convex, concave, convex_exit, concave_exit })
+        Some(CurvatureChannel { unit_mm, convex, concave, convex_exit, concave_exit, convex_exit_far, concave_exit_far })
     }
 }
 
@@ -143,6 +148,8 @@ fn flat(unit_mm: f64) -> CurvatureChannel {
         concave: vec![[1.0; ENTRIES]; CURVATURE_NODES],
         convex_exit: vec![[1.0; EXIT_BINS]; CURVATURE_NODES],
         concave_exit: vec![[1.0; EXIT_BINS]; CURVATURE_NODES],
+        convex_exit_far: vec![[1.0; EXIT_BINS]; CURVATURE_NODES],
+        concave_exit_far: vec![[1.0; EXIT_BINS]; CURVATURE_NODES],
     }
 }
 
@@ -247,7 +254,7 @@ fn measure(m: &Medium, unit_mm: f64) -> CurvatureChannel {
         })
     });
     // Signed radius in this channel's mean free paths: the node's ratios per entry and per exit bin.
-    let row = |radius: f64| -> ([f64; ENTRIES], [f64; EXIT_BINS]) {
+    let row = |radius: f64| -> ([f64; ENTRIES], ([f64; EXIT_BINS], [f64; EXIT_BINS])) {
         let (curved, _) = counts(sigma_t, unit_mm, Some(photons), |seed, tally| {
             sphere::trace_sphere(albedo, m.eta, radius, start, 1, (seed, MAX_COLLISIONS), |e| {
                 tally(e.position, e.mu_o2, e.scatterings)
@@ -256,7 +263,7 @@ fn measure(m: &Medium, unit_mm: f64) -> CurvatureChannel {
         let radius_mm = radius / sigma_t;
         (
             ratios(&totals(&curved), &totals(&flat_counts), radius_mm, unit_mm),
-            exit_ratios(&curved, &flat_counts, radius_mm, unit_mm),
+            (exit_ratios(&curved, &flat_counts, radius_mm, unit_mm, false), exit_ratios(&curved, &flat_counts, radius_mm, unit_mm, true)),
         )
     };
     let radius_of = |k: usize| unit_mm / node_curvature(k) * sigma_t;
@@ -273,9 +280,11 @@ fn measure(m: &Medium, unit_mm: f64) -> CurvatureChannel {
             .collect();
         handles.into_iter().map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e))).collect()
     });
-    let (convex, convex_exit) = rows[..CURVATURE_NODES].iter().cloned().unzip();
-    let (concave, concave_exit) = rows[CURVATURE_NODES..].iter().cloned().unzip();
-    CurvatureChannel { unit_mm, convex, concave, convex_exit, concave_exit }
+    let (convex, exits): (Vec<_>, Vec<_>) = rows[..CURVATURE_NODES].iter().cloned().unzip();
+    let (convex_exit, convex_exit_far) = exits.into_iter().unzip();
+    let (concave, exits): (Vec<_>, Vec<_>) = rows[CURVATURE_NODES..].iter().cloned().unzip();
+    let (concave_exit, concave_exit_far) = exits.into_iter().unzip();
+    CurvatureChannel { unit_mm, convex, concave, convex_exit, concave_exit, convex_exit_far, concave_exit_far }
 }
 
 /// Escapes per entry, over the exit bins.
@@ -284,14 +293,18 @@ fn totals(c: &Counts) -> [u64; ENTRIES] {
 }
 
 /// The ratio per exit bin of the curved surface's exit distribution to the flat one's, each
-/// normalised over the bins, of the escapes within a chord |R|√2 (at least the first entry):
-/// over three bins (weights 1 2 1, the ends 3 1) for the walks' noise; 1 where either counted
-/// under MIN_COUNT in all, or in the bin.
-fn exit_ratios(curved: &Counts, flat: &Counts, radius_mm: f64, unit_mm: f64) -> [f64; EXIT_BINS] {
+/// normalised over the bins, of the escapes within a chord |R|√2 (at least the first entry; `far`:
+/// the curved surface's escapes beyond it, against the same flat ones): over three bins (weights
+/// 1 2 1, the ends 3 1) for the walks' noise; 1 where either counted under MIN_COUNT in all, or
+/// in the bin. Light that crossed a ball leaves it nearer its normal (Skin1's red at R = 5 mm,
+/// past 90° from the entry: 0.8 of the half-space's share in the most grazing bins, 1.2-1.5 in the
+/// most normal; examples/cylinder_walk.rs `exits`).
+fn exit_ratios(curved: &Counts, flat: &Counts, radius_mm: f64, unit_mm: f64, far: bool) -> [f64; EXIT_BINS] {
     let cut = entry_of(radius_mm.abs() * std::f64::consts::SQRT_2, unit_mm).unwrap_or(ENTRIES).max(1);
-    let bins =
-        |c: &Counts| -> [f64; EXIT_BINS] { std::array::from_fn(|b| c[..cut].iter().map(|bins| bins[b] as f64).sum()) };
-    let (curved, flat) = (bins(curved), bins(flat));
+    let sum = |c: &Counts, range: std::ops::Range<usize>| -> [f64; EXIT_BINS] {
+        std::array::from_fn(|b| c[range.clone()].iter().map(|bins| bins[b] as f64).sum())
+    };
+    let (curved, flat) = (if far { sum(curved, cut..ENTRIES) } else { sum(curved, 0..cut) }, sum(flat, 0..cut));
     let smooth = |c: &[f64; EXIT_BINS], b: usize| match b {
         0 => 3.0 * c[0] + c[1],
         _ if b == EXIT_BINS - 1 => c[b - 1] + 3.0 * c[b],
@@ -380,11 +393,18 @@ impl CurvatureChannel {
     /// The exit distribution's ratio at exit cosine `cos_o` (outside) and curvature `kappa`
     /// (1/mm): linear in cos²θo between the bins' centres (held beyond the outer ones, as the
     /// table's exit factor h), and between nodes as [`CurvatureChannel::ratio`].
-    pub fn exit_ratio(&self, cos_o: f64, kappa: f64) -> f64 {
+    /// `far`: the share of the light that came from beyond a chord R√2, whose rows it weighs.
+    pub fn exit_ratio(&self, cos_o: f64, kappa: f64, far: f64) -> f64 {
         if self.unit_mm.is_nan() || self.unit_mm <= 0.0 {
             return 1.0;
         }
-        let rows = if kappa < 0.0 { &self.concave_exit } else { &self.convex_exit };
+        let near = self.exit_ratio_of(if kappa < 0.0 { &self.concave_exit } else { &self.convex_exit }, cos_o, kappa);
+        let beyond =
+            self.exit_ratio_of(if kappa < 0.0 { &self.concave_exit_far } else { &self.convex_exit_far }, cos_o, kappa);
+        near + (beyond - near) * far
+    }
+
+    fn exit_ratio_of(&self, rows: &[[f64; EXIT_BINS]], cos_o: f64, kappa: f64) -> f64 {
         let (a_row, b_row, f) = self.nodes_at(kappa);
         let y = (cos_o * cos_o * EXIT_BINS as f64 - 0.5).clamp(0.0, (EXIT_BINS - 1) as f64);
         let j = (y.floor() as usize).min(EXIT_BINS - 2);
