@@ -184,7 +184,15 @@ fn exits(material: &str, r_mm: f64, photons: u64) {
             let b = ((mu2 * 10.0) as usize).min(9);
             let angle = (p.z + r).atan2((p.x * p.x + p.y * p.y).sqrt());
             let polar = std::f64::consts::FRAC_PI_2 - angle; // from the entry's axis
-            let group = if p.length() < r * std::f64::consts::SQRT_2 { 0 } else if polar < 2.0 * PI / 3.0 { 1 } else if polar < 5.0 * PI / 6.0 { 2 } else { 3 };
+            let group = if p.length() < r * std::f64::consts::SQRT_2 {
+                0
+            } else if polar < 2.0 * PI / 3.0 {
+                1
+            } else if polar < 5.0 * PI / 6.0 {
+                2
+            } else {
+                3
+            };
             bins[group][b] += 1.0;
         });
         walk(Shape::Plane, albedo, m.eta, photons, 3, |_, mu2| bins[4][((mu2 * 10.0) as usize).min(9)] += 1.0);

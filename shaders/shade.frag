@@ -317,24 +317,27 @@ vec3 interval_integral(vec3 sigma, float g0, float g1, float len) {
 }
 
 // The surface the shadow map sees at `uv` (its texel's centre, unprojected by `unproject`) and
-// its normal turned toward the light (`toward`), from the depths of that texel and of the next
-// ones across and up; false where they do not span a surface (beyond the map, a silhouette seen
-// from the light).
+// its normal turned toward the light (`toward`), from the depths of its neighbours on either side
+// across and up (central differences: a forward difference three texels long tilted the normal
+// where light grazes, and the back-lit Skin1 sphere's blue single scattering moved by 8% between
+// 1024² and 8192² maps, its whole image by 2.7% between 1024² and 4096², 1.5% now); false where
+// they do not span a surface (beyond the map, a silhouette seen from the light).
 bool entry_surface(vec2 uv, uint layer, mat4 unproject, vec3 toward, out vec3 point, out vec3 normal) {
     vec2 size = vec2(textureSize(shadow_depth, 0).xy);
     vec2 centre = (floor(uv * size) + 0.5) / size;
-    vec3 p[3];
+    vec3 p[5];
     point = vec3(0.0);
     normal = toward;
     if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return false;
-    for (int j = 0; j < 3; ++j) {
-        vec2 at = centre + (j == 1 ? vec2(3.0, 0.0) : (j == 2 ? vec2(0.0, 3.0) : vec2(0.0))) / size;
+    const vec2 offsets[5] = vec2[](vec2(0.0), vec2(1.0, 0.0), vec2(-1.0, 0.0), vec2(0.0, 1.0), vec2(0.0, -1.0));
+    for (int j = 0; j < 5; ++j) {
+        vec2 at = centre + offsets[j] / size;
         float d = texture(shadow_depth, vec3(at, float(layer))).r;
         if (d >= 1.0) return false;
         vec4 q = unproject * vec4(at * 2.0 - 1.0, d, 1.0);
         p[j] = q.xyz / q.w;
     }
-    vec3 n = cross(p[1] - p[0], p[2] - p[0]);
+    vec3 n = cross(p[1] - p[2], p[3] - p[4]);
     float len = length(n);
     if (!(len > 0.0)) return false;
     point = p[0];

@@ -136,7 +136,15 @@ impl super::table_cache::Flat for CurvatureChannel {
         let (convex_exit, concave_exit) = (rows::<EXIT_BINS>(t.vec()?)?, rows::<EXIT_BINS>(t.vec()?)?);
         let (convex_exit_far, concave_exit_far) = (rows::<EXIT_BINS>(t.vec()?)?, rows::<EXIT_BINS>(t.vec()?)?);
         t.end()?;
-        Some(CurvatureChannel { unit_mm, convex, concave, convex_exit, concave_exit, convex_exit_far, concave_exit_far })
+        Some(CurvatureChannel {
+            unit_mm,
+            convex,
+            concave,
+            convex_exit,
+            concave_exit,
+            convex_exit_far,
+            concave_exit_far,
+        })
     }
 }
 
@@ -263,7 +271,10 @@ fn measure(m: &Medium, unit_mm: f64) -> CurvatureChannel {
         let radius_mm = radius / sigma_t;
         (
             ratios(&totals(&curved), &totals(&flat_counts), radius_mm, unit_mm),
-            (exit_ratios(&curved, &flat_counts, radius_mm, unit_mm, false), exit_ratios(&curved, &flat_counts, radius_mm, unit_mm, true)),
+            (
+                exit_ratios(&curved, &flat_counts, radius_mm, unit_mm, false),
+                exit_ratios(&curved, &flat_counts, radius_mm, unit_mm, true),
+            ),
         )
     };
     let radius_of = |k: usize| unit_mm / node_curvature(k) * sigma_t;
