@@ -325,22 +325,22 @@ vec3 interval_integral(vec3 sigma, float g0, float g1, float len) {
 bool entry_surface(vec2 uv, uint layer, mat4 unproject, vec3 toward, out vec3 point, out vec3 normal) {
     vec2 size = vec2(textureSize(shadow_depth, 0).xy);
     vec2 centre = (floor(uv * size) + 0.5) / size;
-    vec3 p[5];
+    vec3 p[4];
     point = vec3(0.0);
     normal = toward;
     if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return false;
-    const vec2 offsets[5] = vec2[](vec2(0.0), vec2(1.0, 0.0), vec2(-1.0, 0.0), vec2(0.0, 1.0), vec2(0.0, -1.0));
-    for (int j = 0; j < 5; ++j) {
+    const vec2 offsets[4] = vec2[](vec2(1.0, 0.0), vec2(-1.0, 0.0), vec2(0.0, 1.0), vec2(0.0, -1.0));
+    for (int j = 0; j < 4; ++j) {
         vec2 at = centre + offsets[j] / size;
         float d = texture(shadow_depth, vec3(at, float(layer))).r;
         if (d >= 1.0) return false;
         vec4 q = unproject * vec4(at * 2.0 - 1.0, d, 1.0);
         p[j] = q.xyz / q.w;
     }
-    vec3 n = cross(p[1] - p[2], p[3] - p[4]);
+    vec3 n = cross(p[0] - p[1], p[2] - p[3]);
     float len = length(n);
     if (!(len > 0.0)) return false;
-    point = p[0];
+    point = 0.25 * (p[0] + p[1] + p[2] + p[3]);
     normal = dot(n, toward) < 0.0 ? -n / len : n / len;
     return true;
 }
