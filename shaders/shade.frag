@@ -292,9 +292,8 @@ vec3 specular(vec3 xo, vec3 no, vec3 wo) {
 // lights weighted by the luminance of what each brings in; 1 (normal incidence) where none
 // reaches it. The Monte Carlo table's exit factor is read there.
 float own_cos_t() {
-    vec3 luminance = vec3(0.2126, 0.7152, 0.0722);
-    float weight = dot(luminance, own_irradiance);
-    float sum = dot(luminance, vec3(own_incident[0].w, own_incident[1].w, own_incident[2].w));
+    float weight = dot(LUMINANCE, own_irradiance);
+    float sum = dot(LUMINANCE, vec3(own_incident[0].w, own_incident[1].w, own_incident[2].w));
     return weight > 0.0 ? sum / weight : 1.0;
 }
 
@@ -630,7 +629,7 @@ void main() {
             for (uint k = 0u; k < FAR_FIELD_SAMPLES; ++k) {
                 vec4 far = (wu[k % 4u] * wv[k / 4u]) * texel_float(far_field, tile_index * FAR_FIELD_SAMPLES + k);
                 sum += far.xyz;
-                far_light += vec2(far.w, dot(far.xyz, vec3(0.2126, 0.7152, 0.0722)));
+                far_light += vec2(far.w, dot(far.xyz, LUMINANCE));
             }
         }
 

@@ -7,6 +7,7 @@
 // pixel before any source.
 #ifndef SOURCES_GLSL
 #define SOURCES_GLSL
+#include "common.glsl"
 vec4 dipole_header; // its texel 0, read once per pixel
 vec4 slab_header; // the Monte Carlo table's slab header (L in mm, scales), read once per pixel (0 for the other models)
 // The Monte Carlo table's curvature rows at the pixel's mean curvature (curvature_rows), smoothed
@@ -28,7 +29,7 @@ float pixel_curvature_mm = 0.0;
 // normal (curvature_exit's far rows), weighed by x/y per pixel.
 vec2 far_light = vec2(0.0);
 void count_far(float r_kappa, vec3 contribution) {
-    float luminance = dot(contribution, vec3(0.2126, 0.7152, 0.0722));
+    float luminance = dot(contribution, LUMINANCE);
     far_light += vec2(r_kappa >= 1.41421356 ? luminance : 0.0, luminance);
 }
 
@@ -79,7 +80,7 @@ vec3 across(vec3 xi, vec3 ni, vec3 xo, vec3 no, vec3 sd, vec3 power_mm) {
     w = min(w, 1.0) * (1.0 - clamp(pixel_curvature_mm * t, 0.0, 1.0));
     vec3 through = w * slab_transmission(dipole_table, slab_header, rho, t) * power_mm;
     across_sum += through;
-    float luminance = dot(through, vec3(0.2126, 0.7152, 0.0722));
+    float luminance = dot(through, LUMINANCE);
     across_thickness += vec2(t * luminance, luminance);
     return (1.0 - w) * sd;
 }
