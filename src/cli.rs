@@ -210,6 +210,29 @@ impl From<DiffusionArg> for Diffusion {
     }
 }
 
+/// Which of the Monte Carlo table's terms a render draws (`--scattering`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ScatteringArg {
+    /// Single and multiple scattering: the image.
+    All,
+    /// Light scattered once inside, alone (to check it against a path tracer limited to one
+    /// scattering, `scripts/reference --max-depth 4`).
+    Single,
+    /// Light scattered twice or more, alone.
+    Multiple,
+}
+
+impl From<ScatteringArg> for crate::frame_desc::Scattering {
+    fn from(s: ScatteringArg) -> Self {
+        use crate::frame_desc::Scattering;
+        match s {
+            ScatteringArg::All => Scattering::All,
+            ScatteringArg::Single => Scattering::Single,
+            ScatteringArg::Multiple => Scattering::Multiple,
+        }
+    }
+}
+
 /// When the near-field split applies (`--near-field`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum NearFieldArg {
@@ -440,6 +463,10 @@ pub struct RenderArgs {
     /// Leave out the surface's own (microfacet) reflection: subsurface scattering alone.
     #[arg(long)]
     pub no_specular: bool,
+    /// Draw single scattering alone, multiple scattering alone, or both (`--model mc` only: the
+    /// other models' profiles hold both in one).
+    #[arg(long, value_enum, default_value = "all")]
+    pub scattering: ScatteringArg,
     /// Roughness of the microfacet reflection, in (0, 1] (GGX α = roughness²).
     #[arg(long, allow_hyphen_values = true, default_value_t = crate::frame_desc::DEFAULT_ROUGHNESS, value_parser = finite_f32)]
     pub roughness: f32,

@@ -566,7 +566,7 @@ impl Renderer {
                 roughness: desc.roughness,
                 near_field: integration.splits_near_field() as u32,
                 far_field: integration.uses_far_field() as u32,
-                pad: 0,
+                scattering: desc.scattering.code(),
             }],
         )?;
         self.generation += 1;

@@ -59,6 +59,37 @@ pub struct Integration {
     pub far_field: bool,
 }
 
+/// The Monte Carlo table's terms a frame draws: the shade pass's single scattering (light
+/// scattered once, along the refracted view ray) and its multiple scattering (the table's
+/// profile over the sources), or one of them alone.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Scattering {
+    #[default]
+    All,
+    Single,
+    Multiple,
+}
+
+impl Scattering {
+    /// The name `--scattering` takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            Scattering::All => "all",
+            Scattering::Single => "single",
+            Scattering::Multiple => "multiple",
+        }
+    }
+
+    /// Its value in the shade pass's FrameParams.scattering.
+    pub fn code(self) -> u32 {
+        match self {
+            Scattering::All => 0,
+            Scattering::Single => 1,
+            Scattering::Multiple => 2,
+        }
+    }
+}
+
 /// When the near-field split applies (see [`Integration::near_field`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum NearField {
@@ -112,6 +143,8 @@ pub struct FrameDesc {
     pub integration: Integration,
     /// Add the surface's microfacet reflection (`--no-specular` turns it off).
     pub specular: bool,
+    /// The Monte Carlo table's terms drawn (`--scattering`).
+    pub scattering: Scattering,
     /// Roughness of the microfacet lobe (α = roughness²), in (0, 1].
     pub roughness: f32,
     pub show: Show,
@@ -136,6 +169,7 @@ impl FrameDesc {
             height: 512,
             integration: Integration::default(),
             specular: true,
+            scattering: Scattering::All,
             roughness: DEFAULT_ROUGHNESS,
             show: Show::Shading,
             exposure: Exposure::Auto,
@@ -152,6 +186,13 @@ impl FrameDesc {
             return Err(bad_input!("--epsilon {e}: must be a finite number ≥ 0"));
         }
         check_roughness(self.roughness, "--roughness")?;
+        if self.scattering != Scattering::All && self.integration.model != Model::Mc {
+            return Err(bad_input!(
+                "--scattering {}: only --model mc draws single and multiple scattering apart (model {})",
+                self.scattering.name(),
+                self.integration.model.name()
+            ));
+        }
         if self.width == 0 || self.height == 0 {
             return Err(bad_input!("image size {}x{}: width and height must be at least 1", self.width, self.height));
         }

@@ -257,6 +257,7 @@ impl RenderSettings {
         };
         (d.width, d.height) = (args.width, args.height);
         (d.specular, d.roughness) = (!args.no_specular, args.roughness);
+        d.scattering = args.scattering.into();
         d.shadow_resolution = args.shadow_resolution;
         d.show = match args.show {
             ShowArg::Shading => Show::Shading,

@@ -74,6 +74,8 @@ fn bad_flag_values() {
     assert_bad_input(&["--roughness", "nan"], "--roughness");
     assert_bad_input(&["--spin-light", "inf"], "--spin-light");
     assert_bad_input(&["--epsilon", "-1"], "--epsilon");
+    assert_bad_input(&["--model", "pbd", "--scattering", "single"], "--scattering");
+    assert_bad_input(&["--scattering", "twice"], "--scattering");
 }
 
 #[test]

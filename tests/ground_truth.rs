@@ -57,39 +57,48 @@ fn skin1_thin_slab_against_the_path_tracer() {
 /// (tests/data/mitsuba-images: the cases' exports, `scripts/reference --spp 1024 --seeds 4`, the
 /// bunnies 4096 × 4), over the pixels both cover fully, as `compare` (at the silhouette the
 /// selection moves a back-lit mean by 4%). Each case is held to its measured ratio within 4%
-/// (6% where the expectation is 1), so that it fails if the model moves either way: a fix of a
+/// so that it fails if the model moves either way: a fix of a
 /// deficit updates the numbers here, with its cause.
 /// - The 10 mm Skin1 sphere: the curvature ratios and the oblique entry's harmonic
-///   (src/physics/curvature_profile.rs, mc_profile.rs) bring the front-lit one within 6%
-///   (measured 1.051 1.034 1.010), where the flat half-space's profile gave 0.88 0.90 0.93.
-///   Back-lit 0.920 0.858 0.803 (0.917 0.853 0.789 before the entry's normal was taken by central
-///   differences of the shadow map, shade.frag `entry_surface`; the half-space's 0.51 0.53 0.80; 0.898 0.847 0.788 before the
-///   curvature rows held their antipode's ratio past a ball's diameter): single scattering, now
-///   entering where refracted light really enters (shade.frag, light_entry), no longer lights
-///   the inside beyond the terminator, which had added 5 / 12 / 23% and hidden that much of a
-///   deficit of the multiple scattering (README, "Curved objects in the Monte Carlo table").
+///   (src/physics/curvature_profile.rs, mc_profile.rs) take the front-lit one to 1.070 1.052
+///   1.028, where the flat half-space's profile gave 0.88 0.90 0.93. Its single scattering is
+///   within 1–2% of the path tracer's (`single_scattering_against_the_path_tracer`); the
+///   multiple scattering is 1.083 1.067 1.034 of the path tracer's light scattered twice or
+///   more (its image less the one-scattering reference): too bright toward the terminator
+///   (tests/curvature_profile.rs, the ring by ring walk). (1.051 1.034 1.010 before single
+///   scattering took in the beam's focusing by the curved entry, which hid that much of it.)
+///   Back-lit 0.937 0.877 0.818, of which single scattering 0.931 0.930 0.918 and multiple
+///   0.936 0.869 0.766 (0.920 0.858 0.803 before the focusing; 0.917 0.853 0.789 before the
+///   entry's normal was taken by central differences of the shadow map, shade.frag
+///   `entry_surface`; the half-space's 0.51 0.53 0.80; 0.898 0.847 0.788 before the curvature
+///   rows held their antipode's ratio past a ball's diameter): single scattering, entering
+///   where refracted light really enters (shade.frag, light_entry), no longer lights the inside
+///   beyond the terminator, which had added 5 / 12 / 23% and hidden that much of a deficit of
+///   the multiple scattering (README, "Curved objects in the Monte Carlo table").
 /// - A 16 mm Skin1 box behind the default light, where light turns the edges from the lit top,
 ///   back and left faces to the three the camera sees: 1.218 1.114 1.019, each pair read at its
 ///   own curvature along the way (`pair_curvature`); read at the pixel's mean curvature (0 on
 ///   the faces) it was 0.68 0.53 0.54.
 /// - A Skin1 torus (22 mm across, its tube 5.6 mm thick), whose inside is a saddle (concave
-///   around the ring): front-lit 1.046 1.039 1.027, back-lit 1.013 0.960 0.933 (at the pixel's
-///   mean curvature 1.083 1.029 1.009 and 0.965 0.841 0.837).
-/// - The default bunny (128 × 96, the default tree and samples), Skin1 and Marble: 0.951 0.826
-///   0.773 and 0.970 0.942 0.899 (0.938 0.814 0.761 and 0.967 0.936 0.898 before the far light's
-///   exit rows and the entry's central differences; at the pixel's mean curvature 0.914 0.725 0.644 and 0.940
-///   0.908 0.866; the flat half-space's 0.62 0.54 0.60 and 0.84 0.80 0.76).
+///   around the ring): front-lit 1.063 1.057 1.046, back-lit 1.027 0.973 0.943 (1.046 1.039
+///   1.027 and 1.013 0.960 0.933 before the focusing; at the pixel's mean curvature 1.083 1.029
+///   1.009 and 0.965 0.841 0.837).
+/// - The default bunny (128 × 96, the default tree and samples), Skin1 and Marble: 0.951 0.831
+///   0.784 and 0.971 0.943 0.900 (0.951 0.826 0.773 and 0.970 0.942 0.899 before the focusing;
+///   0.938 0.814 0.761 and 0.967 0.936 0.898 before the far light's exit rows and the entry's
+///   central differences; at the pixel's mean curvature 0.914 0.725 0.644 and 0.940 0.908
+///   0.866; the flat half-space's 0.62 0.54 0.60 and 0.84 0.80 0.76).
 #[test]
 fn curved_objects_against_the_path_tracer() {
     let brute = ["--brute-force", "--samples", "100000"];
     let cases: [(&str, &[&str], [f64; 3]); 7] = [
-        ("skin1/sphere-front", &brute, [1.0; 3]),
-        ("skin1/sphere-back", &brute, [0.920, 0.858, 0.803]),
+        ("skin1/sphere-front", &brute, [1.070, 1.052, 1.028]),
+        ("skin1/sphere-back", &brute, [0.937, 0.877, 0.818]),
         ("skin1/box-back", &brute, [1.218, 1.114, 1.019]),
-        ("skin1/torus-front", &brute, [1.046, 1.037, 1.025]),
-        ("skin1/torus-back", &brute, [1.013, 0.960, 0.933]),
-        ("skin1/bunny", &[], [0.951, 0.826, 0.773]),
-        ("marble/bunny", &[], [0.970, 0.942, 0.899]),
+        ("skin1/torus-front", &brute, [1.063, 1.057, 1.046]),
+        ("skin1/torus-back", &brute, [1.027, 0.973, 0.943]),
+        ("skin1/bunny", &[], [0.951, 0.831, 0.784]),
+        ("marble/bunny", &[], [0.971, 0.943, 0.900]),
     ];
     for (name, sampling, expected) in cases {
         let c = case(name);
@@ -109,12 +118,7 @@ fn curved_objects_against_the_path_tracer() {
         for (ch, stats) in cmp.channels.iter().enumerate() {
             let ratio = stats.ratio.expect("a lit reference");
             println!("{name} mc channel {ch}: translucent / path traced = {ratio:.4} over {} pixels", cmp.pixels);
-            let bound = if expected[ch] == 1.0 { 0.06 } else { 0.04 };
-            assert!(
-                (ratio / expected[ch] - 1.0).abs() < bound,
-                "{name} channel {ch}: {ratio} against {}",
-                expected[ch]
-            );
+            assert!((ratio / expected[ch] - 1.0).abs() < 0.04, "{name} channel {ch}: {ratio} against {}", expected[ch]);
         }
     }
 }
@@ -146,6 +150,65 @@ fn single_scattering_converges_with_the_shadow_map() {
         let change = coarse / fine - 1.0;
         println!("channel {c}: 1024² / 4096² - 1 = {:.4}", change);
         assert!(change.abs() < 0.02, "channel {c}: {change}");
+    }
+}
+
+/// Single scattering alone (`--scattering single`) on 10 mm spheres against the path tracer
+/// limited to light scattered once (`scripts/reference --max-depth 4`; tests/data/mitsuba-images
+/// `*-single.exr`): within 10% of it in every case and channel, and held to its measured ratio
+/// within 3% (the references' noise of the mean 0.04–2.4%). Measured 0.931 0.930 0.918 (Skin1
+/// back-lit), 0.931 0.937 0.916 (Ketchup back-lit), 1.013 1.017 1.022 (Skin1 front-lit), 1.013
+/// 1.014 1.013 (Potato front-lit). Before the beam's focusing by the curved entry (shade.frag
+/// `lens_gain`), the stricter test of whether refracted light reaches a point and the interval's
+/// mean beam: 0.767 0.835 0.882, 0.595 0.895 0.939, 0.928 0.956 0.979, 0.916 0.921 0.914. What
+/// the back-lit spheres still miss (an exact sum over the ball's refracted rays, README): near
+/// the fold of the refracted light past the terminator two entries reach a point and the steps
+/// find one, and the ball focuses light onto its far pole, where the gain is held.
+#[test]
+fn single_scattering_against_the_path_tracer() {
+    for name in [
+        "skin1/sphere-back-single",
+        "ketchup/sphere-back-single",
+        "skin1/sphere-front-single",
+        "potato/sphere-front-single",
+    ] {
+        let c = case(name);
+        let options = c["render_options"].as_str().expect("render options");
+        let measured: Vec<f64> = c["ratio_translucent_over_path_traced"]["mc"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        let tag = name.replace('/', "-");
+        let out = output_dir().join(format!("ground-truth-{tag}.exr"));
+        let out_s = out.to_str().unwrap().to_string();
+        let mut args: Vec<&str> = vec!["render", "--validation"];
+        args.extend(options.split_whitespace());
+        args.extend([
+            "--model",
+            "mc",
+            "--scattering",
+            "single",
+            "--brute-force",
+            "--samples",
+            "100000",
+            "--out",
+            &out_s,
+        ]);
+        let run = translucent(&args);
+        assert_eq!(run.status.code(), Some(0), "{}", String::from_utf8_lossy(&run.stderr));
+        let reference = repo_path(&format!("tests/data/mitsuba-images/{tag}.exr"));
+        let (cmp, _) = translucent::compare::compare(&out, &reference, &Default::default()).expect("compare");
+        for (ch, stats) in cmp.channels.iter().enumerate() {
+            let ratio = stats.ratio.expect("a lit reference");
+            println!(
+                "{name} channel {ch}: single scattering / path traced = {ratio:.4} (recorded {:.4})",
+                measured[ch]
+            );
+            assert!((ratio - 1.0).abs() < 0.1, "{name} channel {ch}: {ratio} of the path tracer");
+            assert!((ratio / measured[ch] - 1.0).abs() < 0.03, "{name} channel {ch}: {ratio} against {}", measured[ch]);
+        }
     }
 }
 

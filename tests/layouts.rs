@@ -47,6 +47,7 @@ fn shading_params_and_tree_match_glsl() {
             offset_of!(FrameParams, roughness),
             offset_of!(FrameParams, near_field),
             offset_of!(FrameParams, far_field),
+            offset_of!(FrameParams, scattering),
         ]
         .iter()
         .map(|&o| o as u32)

@@ -27,6 +27,6 @@ struct FrameParams {
     float roughness;           // of the microfacet lobe; alpha = roughness²
     uint near_field;           // 1: split each pixel's sum into the near field and the far (see ObjectParams)
     uint far_field;            // 1: sources far from an 8x8 tile are summed at nine of its pixels (far_field.comp)
-    uint pad2;
+    uint scattering;           // the Monte Carlo table's terms: 0 both, 1 single scattering alone, 2 multiple alone
 };
 #endif

@@ -111,5 +111,7 @@ pub struct FrameParams {
     /// 1 to sum the sources far from an 8x8 list tile at nine of its pixels and interpolate
     /// (shaders/far_field.comp).
     pub far_field: u32,
-    pub pad: u32,
+    /// The Monte Carlo table's terms: 0 both, 1 single scattering alone, 2 multiple alone
+    /// ([`crate::frame_desc::Scattering::code`]).
+    pub scattering: u32,
 }
