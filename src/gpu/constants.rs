@@ -31,7 +31,7 @@ pub const SLAB_FIRST_NODE_LOG2_PLUS_8: u32 = 4;
 /// table of them (gpu::sd_table::CurvatureRatios).
 pub const CURVATURE_NODES: u32 = 8;
 pub const CURVATURE_FIRST_LOG2_PLUS_8: u32 = 4;
-pub const CURVATURE_TABLE_ENTRIES: u32 = 512;
+pub const CURVATURE_TABLE_ENTRIES: u32 = 1024;
 
 /// Set in a tree node's child index when the child is a point (index into the sorted points).
 pub const LEAF_BIT: u32 = 0x8000_0000;

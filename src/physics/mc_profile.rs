@@ -258,16 +258,15 @@ pub fn critical_cos_t(eta: f64) -> f64 {
 impl McProfile {
     /// Measures one channel (deterministic: fixed seeds). Cached: a medium measured once is not
     /// measured again in this process (the viewer switching models, several objects of one material).
+    /// Two threads asking for one medium at once (the curvature table reads this profile) measure
+    /// it once: the second waits for the first.
     pub fn of(m: &Medium) -> Arc<McProfile> {
-        static CACHE: OnceLock<Mutex<HashMap<[u64; 4], Arc<McProfile>>>> = OnceLock::new();
+        type Cell = Arc<OnceLock<Arc<McProfile>>>;
+        static CACHE: OnceLock<Mutex<HashMap<[u64; 4], Cell>>> = OnceLock::new();
         let key = [m.sigma_a, m.sigma_s, m.g, m.eta].map(f64::to_bits);
         let cache = CACHE.get_or_init(Default::default);
-        if let Some(p) = cache.lock().unwrap_or_else(|e| e.into_inner()).get(&key) {
-            return p.clone();
-        }
-        let p = Arc::new(super::table_cache::cached("half-space", &key, || McProfile::measure(m)));
-        cache.lock().unwrap_or_else(|e| e.into_inner()).insert(key, p.clone());
-        p
+        let cell = cache.lock().unwrap_or_else(|e| e.into_inner()).entry(key).or_default().clone();
+        cell.get_or_init(|| Arc::new(super::table_cache::cached("half-space", &key, || McProfile::measure(m)))).clone()
     }
 
     /// Measures the three channels of a material, in parallel.
