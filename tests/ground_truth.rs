@@ -106,23 +106,8 @@ fn curved_objects_against_the_path_tracer() {
         ("marble/bunny", &[], [0.971, 0.943, 0.901]),
     ];
     for (name, sampling, expected) in cases {
-        let c = case(name);
-        let options = c["render_options"].as_str().expect("render options");
-        let tag = name.replace('/', "-");
-        let out = output_dir().join(format!("ground-truth-{tag}-mc.exr"));
-        let mut args: Vec<&str> = vec!["render", "--validation"];
-        args.extend(options.split_whitespace());
-        let out_s = out.to_str().unwrap().to_string();
-        args.extend(["--model", "mc"]);
-        args.extend(sampling);
-        args.extend(["--out", &out_s]);
-        let run = translucent(&args);
-        assert_eq!(run.status.code(), Some(0), "{}", String::from_utf8_lossy(&run.stderr));
-        let reference = repo_path(&format!("tests/data/mitsuba-images/{tag}.exr"));
-        let (cmp, _) = translucent::compare::compare(&out, &reference, &Default::default()).expect("compare");
-        for (ch, stats) in cmp.channels.iter().enumerate() {
-            let ratio = stats.ratio.expect("a lit reference");
-            println!("{name} mc channel {ch}: translucent / path traced = {ratio:.4} over {} pixels", cmp.pixels);
+        for (ch, ratio) in mc_against_its_reference(name, sampling).into_iter().enumerate() {
+            println!("{name} mc channel {ch}: translucent / path traced = {ratio:.4}");
             assert!((ratio / expected[ch] - 1.0).abs() < 0.04, "{name} channel {ch}: {ratio} against {}", expected[ch]);
         }
     }
@@ -177,36 +162,14 @@ fn single_scattering_against_the_path_tracer() {
         "skin1/sphere-front-single",
         "potato/sphere-front-single",
     ] {
-        let c = case(name);
-        let options = c["render_options"].as_str().expect("render options");
-        let measured: Vec<f64> = c["ratio_translucent_over_path_traced"]["mc"]
+        let measured: Vec<f64> = case(name)["ratio_translucent_over_path_traced"]["mc"]
             .as_array()
             .unwrap()
             .iter()
             .map(|v| v.as_f64().unwrap())
             .collect();
-        let tag = name.replace('/', "-");
-        let out = output_dir().join(format!("ground-truth-{tag}.exr"));
-        let out_s = out.to_str().unwrap().to_string();
-        let mut args: Vec<&str> = vec!["render", "--validation"];
-        args.extend(options.split_whitespace());
-        args.extend([
-            "--model",
-            "mc",
-            "--scattering",
-            "single",
-            "--brute-force",
-            "--samples",
-            "100000",
-            "--out",
-            &out_s,
-        ]);
-        let run = translucent(&args);
-        assert_eq!(run.status.code(), Some(0), "{}", String::from_utf8_lossy(&run.stderr));
-        let reference = repo_path(&format!("tests/data/mitsuba-images/{tag}.exr"));
-        let (cmp, _) = translucent::compare::compare(&out, &reference, &Default::default()).expect("compare");
-        for (ch, stats) in cmp.channels.iter().enumerate() {
-            let ratio = stats.ratio.expect("a lit reference");
+        let sampling = ["--scattering", "single", "--brute-force", "--samples", "100000"];
+        for (ch, ratio) in mc_against_its_reference(name, &sampling).into_iter().enumerate() {
             println!(
                 "{name} channel {ch}: single scattering / path traced = {ratio:.4} (recorded {:.4})",
                 measured[ch]
@@ -215,6 +178,26 @@ fn single_scattering_against_the_path_tracer() {
             assert!((ratio / measured[ch] - 1.0).abs() < 0.03, "{name} channel {ch}: {ratio} against {}", measured[ch]);
         }
     }
+}
+
+/// Case `name` rendered with `--model mc` and `extra` flags, against its path-traced image
+/// (tests/data/mitsuba-images, named after the case): the ratio of means per channel over the
+/// pixels both cover.
+fn mc_against_its_reference(name: &str, extra: &[&str]) -> Vec<f64> {
+    let options = case(name)["render_options"].as_str().expect("render options").to_string();
+    let tag = name.replace('/', "-");
+    let out = output_dir().join(format!("ground-truth-{tag}-mc.exr"));
+    let out_s = out.to_str().unwrap().to_string();
+    let mut args: Vec<&str> = vec!["render", "--validation"];
+    args.extend(options.split_whitespace());
+    args.extend(["--model", "mc"]);
+    args.extend(extra);
+    args.extend(["--out", &out_s]);
+    let run = translucent(&args);
+    assert_eq!(run.status.code(), Some(0), "{}", String::from_utf8_lossy(&run.stderr));
+    let reference = repo_path(&format!("tests/data/mitsuba-images/{tag}.exr"));
+    let (cmp, _) = translucent::compare::compare(&out, &reference, &Default::default()).expect("compare");
+    cmp.channels.iter().map(|stats| stats.ratio.expect("a lit reference")).collect()
 }
 
 /// Renders case `name` with each of `models` and holds each to its recorded ratio, and the Monte
