@@ -163,10 +163,12 @@ vec3 slab_exit_factor(usamplerBuffer table, vec4 header, float t, float cos_o) {
 // cavity's (κ < 0) multiple scattering over the half-space's at chord r, multiplying Sp(r).
 // After the light across: texel CURVATURE_BASE holds L (mm; 0: no ratios), then per side (convex,
 // concave) CURVATURE_NODES rows of CURVATURE_TABLE_ENTRIES texels at the centres of
-// u = r/(r + L), row j's texel holding per channel the ratios of nodes j − 1 (−1: flat, 1) and j
-// (κ_j L = 2^(j + first)) as two f16. `curvature_rows` (once per pixel): the row of κ (1/mm) and
-// the weight of its upper node, linear in κ from flat to node 0 and in log κ between nodes, held
-// past the last; w = L (0 and x = −1: no ratios). `curvature_ratio` (per pair): one fetch, the nearest entry.
+// u = s/(s + 1), s = r|κ| the chord relative to the ball's radius, row j's texel holding per
+// channel the ratios of nodes j − 1 (−1: flat, 1) and j (κ_j L = 2^(j + first)) at the same s
+// (each node read at the same place on its own ball) as two f16. `curvature_rows` (once per
+// pixel): the row of κ (1/mm) and the weight of its upper node, linear in κ from flat to node 0
+// and in log κ between nodes, held past the last; z = |κ|, w = L (0 and x = −1: no ratios).
+// `curvature_ratio` (per pair): one fetch, the nearest entry.
 const int CURVATURE_BASE = SLAB_BASE + 1 + int(SLAB_LOOKUP_NODES * SLAB_ENTRIES + SLAB_THICKNESS_NODES * MC_EXIT_BINS);
 const float CURVATURE_FIRST_LOG2 = float(CURVATURE_FIRST_LOG2_PLUS_8) - 8.0;
 vec4 curvature_rows_at(float unit_mm, float kappa);
@@ -180,14 +182,15 @@ vec4 curvature_rows_at(float unit_mm, float kappa) {
     if (!(x >= 0.0)) x = 0.0; // NaN: flat
     float side = kappa < 0.0 ? float(CURVATURE_NODES) : 0.0;
     float first = exp2(CURVATURE_FIRST_LOG2);
-    if (x < first) return vec4(side, x / first, 0.0, unit_mm);
+    if (x < first) return vec4(side, x / first, x / unit_mm, unit_mm);
     float k = min(log2(x) - CURVATURE_FIRST_LOG2, float(CURVATURE_NODES - 1u));
     float i = min(floor(k), float(CURVATURE_NODES - 2u));
-    return vec4(side + i + 1.0, k - i, 0.0, unit_mm);
+    return vec4(side + i + 1.0, k - i, x / unit_mm, unit_mm);
 }
 vec3 curvature_ratio(usamplerBuffer table, vec4 rows, float r_mm) {
     if (rows.x < 0.0) return vec3(1.0);
-    int e = min(int(r_mm / (r_mm + rows.w) * float(CURVATURE_TABLE_ENTRIES)), int(CURVATURE_TABLE_ENTRIES) - 1);
+    float s = r_mm * rows.z;
+    int e = min(int(s / (s + 1.0) * float(CURVATURE_TABLE_ENTRIES)), int(CURVATURE_TABLE_ENTRIES) - 1);
     uvec3 pairs = texelFetch(table, CURVATURE_BASE + 1 + int(rows.x) * int(CURVATURE_TABLE_ENTRIES) + e).xyz;
     vec2 red = unpackHalf2x16(pairs.x), green = unpackHalf2x16(pairs.y), blue = unpackHalf2x16(pairs.z);
     return mix(vec3(red.x, green.x, blue.x), vec3(red.y, green.y, blue.y), rows.y);

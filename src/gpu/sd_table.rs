@@ -306,7 +306,9 @@ pub const CURVATURE_TABLE_ENTRIES: usize = super::CURVATURE_TABLE_ENTRIES as usi
 
 /// The Monte Carlo table's curvature ratios, after the light across in the same buffer
 /// (bssrdf.glsl's `curvature_rows`, `curvature_ratio`; [`CurvatureChannel`], resampled at
-/// CURVATURE_TABLE_ENTRIES centres of u = r/(r + L)): a header texel (L in mm; 0 for the other
+/// CURVATURE_TABLE_ENTRIES centres of u = s/(s + 1), s = r·κ the chord relative to the node's
+/// radius, so that a texel pairs two nodes at the same place on their balls, as
+/// [`CurvatureChannel::ratio`] reads them): a header texel (L in mm; 0 for the other
 /// models, which never read the rest), then 2N rows of entries, each texel holding per channel
 /// two neighbouring curvature nodes' ratios as two f16, so that one fetch interpolates in κ: on
 /// each side (convex, then concave) row j holds nodes j − 1 and j, node −1 being the flat
@@ -349,11 +351,12 @@ impl CurvatureRatios {
         let nodes = |sign: f64| -> Vec<Vec<[f32; 3]>> {
             (0..curvature_profile::CURVATURE_NODES)
                 .map(|k| {
-                    let kappa = sign * curvature_profile::node_curvature(k) / unit;
+                    let radius = unit / curvature_profile::node_curvature(k);
                     (0..CURVATURE_TABLE_ENTRIES)
                         .map(|i| {
                             let u = (i as f64 + 0.5) / CURVATURE_TABLE_ENTRIES as f64;
-                            [0, 1, 2].map(|c| channels[c].ratio(unit * u / (1.0 - u), kappa) as f32)
+                            let chord = radius * u / (1.0 - u);
+                            [0, 1, 2].map(|c| channels[c].node_ratio(sign < 0.0, k, chord) as f32)
                         })
                         .collect()
                 })
@@ -465,7 +468,8 @@ impl CurvatureRatios {
             return [1.0; 3];
         }
         let nodes = if kappa < 0.0 { &self.concave } else { &self.convex };
-        let e = ((r_mm / (r_mm + unit) * CURVATURE_TABLE_ENTRIES as f64) as usize).min(CURVATURE_TABLE_ENTRIES - 1);
+        let s = if kappa.is_nan() { 0.0 } else { r_mm * kappa.abs() };
+        let e = ((s / (s + 1.0) * CURVATURE_TABLE_ENTRIES as f64) as usize).min(CURVATURE_TABLE_ENTRIES - 1);
         [0, 1, 2].map(|c| self.between_nodes(nodes, kappa, e, c))
     }
 

@@ -19,7 +19,9 @@
 //! `curvature_ratio`) reads it per source at the pair's own curvature along the way between them
 //! ([`pair_curvature`]; the exit's distribution and the light across at the pixel's mean
 //! curvature, the mesh's smoothed over L: `mesh::smoothed_mean_curvature`), linear in κ from the
-//! flat row (1) to node 0 and linear in log κ between nodes, held beyond the last. A chord longer than a sphere's diameter 2R does not
+//! flat row (1) to node 0 and linear in log κ between nodes, held beyond the last, each node read
+//! at the same chord relative to its own radius (r·κ/κ_k: the same place on its ball; the shade
+//! pass's rows are laid out in r·κ). A chord longer than a sphere's diameter 2R does not
 //! exist on it, but a row is read there all the same: a pixel's ball between two nodes is larger
 //! than the smaller node's, and its long chords read that row. So the row holds its antipode's
 //! ratio out to 4R (the next node's diameter) and only then fades to 1, by 8R (the surface is no
@@ -52,8 +54,10 @@ use std::sync::{Arc, Mutex, OnceLock};
 pub const CURVATURE_NODES: usize = 8;
 /// κ_0·L = 2^FIRST_CURVATURE_LOG2.
 pub const FIRST_CURVATURE_LOG2: i32 = -4;
-/// Radial entries per node, at the centres of u = r/(r + L) ∈ [i, i + 1)/ENTRIES.
-pub const ENTRIES: usize = 48;
+/// Radial entries per node, at the centres of u = r/(r + L) ∈ [i, i + 1)/ENTRIES (96: at 48 the
+/// entries near a ball's antipode, where its ratio rises steepest, were 0.2R wide and read 7%
+/// low in red, 18% in green, of the 10 mm Skin1 ball's walk).
+pub const ENTRIES: usize = 96;
 /// Multiply scattered escapes wanted of the half-space walk per channel (its photon count is then
 /// each sphere's), and the caps on photons and on the scatterings a walk may take in all (what
 /// bounds a medium that absorbs almost nothing).
@@ -286,8 +290,15 @@ fn measure(m: &Medium, unit_mm: f64) -> CurvatureChannel {
         });
         let radius_mm = radius / sigma_t;
         let expected = expected.get_or_init(|| expected_counts(&McProfile::of(m), photons, unit_mm));
+        // The share of each entry's chords that a ball has (none past its diameter 2R).
+        let within = if radius_mm > 0.0 {
+            let within = expected_counts_within(&McProfile::of(m), photons, unit_mm, 2.0 * radius_mm);
+            std::array::from_fn(|i| if expected[i] > 0.0 { within[i] / expected[i] } else { 1.0 })
+        } else {
+            [1.0; ENTRIES]
+        };
         (
-            ratios(&totals(&curved), &totals(&flat_counts), expected, radius_mm, unit_mm),
+            ratios(&totals(&curved), &totals(&flat_counts), expected, &within, radius_mm, unit_mm),
             (
                 exit_ratios(&curved, &flat_counts, radius_mm, unit_mm, false),
                 exit_ratios(&curved, &flat_counts, radius_mm, unit_mm, true),
@@ -319,6 +330,11 @@ fn measure(m: &Medium, unit_mm: f64) -> CurvatureChannel {
 /// Carlo table's profile: photons · ∫ M(r) 2πr dr over the entry's chords (midpoints in u,
 /// 64 per entry; the last entry to u = 1 − 1/(64·ENTRIES)).
 fn expected_counts(profile: &McProfile, photons: u64, unit_mm: f64) -> [f64; ENTRIES] {
+    expected_counts_within(profile, photons, unit_mm, f64::INFINITY)
+}
+
+/// The same of the chords shorter than `limit_mm` only.
+fn expected_counts_within(profile: &McProfile, photons: u64, unit_mm: f64, limit_mm: f64) -> [f64; ENTRIES] {
     const STEPS: usize = 64;
     std::array::from_fn(|i| {
         (0..STEPS)
@@ -326,7 +342,11 @@ fn expected_counts(profile: &McProfile, photons: u64, unit_mm: f64) -> [f64; ENT
                 let u = (i as f64 + (j as f64 + 0.5) / STEPS as f64) / ENTRIES as f64;
                 let r = unit_mm * u / (1.0 - u);
                 let dr = unit_mm / ((1.0 - u) * (1.0 - u)) / (ENTRIES * STEPS) as f64;
-                profile.exitance(r) * 2.0 * std::f64::consts::PI * r * dr
+                if r < limit_mm {
+                    profile.exitance(r) * 2.0 * std::f64::consts::PI * r * dr
+                } else {
+                    0.0
+                }
             })
             .sum::<f64>()
             * photons as f64
@@ -374,13 +394,18 @@ fn exit_ratios(curved: &Counts, flat: &Counts, radius_mm: f64, unit_mm: f64, far
 /// where the flat walk counted under MIN_COUNT, to the counts the Monte Carlo table's profile
 /// `expected` (its walk has 3.3 times the escapes, and its product with this ratio is what the
 /// shade pass draws); held where the curved walk counted under MIN_COUNT (the first measured
-/// one before it, the last after), faded to 1 from twice a ball's diameter. Held, as it once was
+/// one before it, the last after), faded to 1 from twice a ball's diameter. `within`: the share
+/// of each entry's flat escapes at chords the ball has (under 2R): the entry across a ball's
+/// diameter counts the ball's escapes of its shorter chords only, and was read against all of the
+/// half-space's (Skin1's red at R = 3.67 mm: 3.6-3.8 held from it where the ball's own walk
+/// finds 4.4-5.3 toward its antipode). Held, as it once was
 /// wherever the flat walk ran out, a 10 mm Skin1 ball's far side read the ratio of 7 mm chords
 /// in green (1.9 L) and 4.3 mm in blue, where the walk's own kept growing.
 fn ratios(
     curved: &[u64; ENTRIES],
     flat: &[u64; ENTRIES],
     expected: &[f64; ENTRIES],
+    within: &[f64; ENTRIES],
     radius_mm: f64,
     unit_mm: f64,
 ) -> [f64; ENTRIES] {
@@ -390,8 +415,8 @@ fn ratios(
         _ if i == ENTRIES - 1 => at(i - 1) + 3.0 * at(i),
         _ => at(i - 1) + 2.0 * at(i) + at(i + 1),
     };
-    let (curved_at, flat_at) = (|j: usize| curved[j] as f64, |j: usize| flat[j] as f64);
-    let expected_at = |j: usize| expected[j];
+    let (curved_at, flat_at) = (|j: usize| curved[j] as f64, |j: usize| flat[j] as f64 * within[j]);
+    let expected_at = |j: usize| expected[j] * within[j];
     let measured: Vec<Option<f64>> = (0..ENTRIES)
         .map(|i| {
             if curved[i] < MIN_COUNT_TAIL {
@@ -424,28 +449,37 @@ fn ratios(
 impl CurvatureChannel {
     /// The ratio at chord `r_mm` and curvature `kappa` (1/mm), linear between the measured
     /// entries (the shade pass's table, gpu::sd_table::CurvatureRatios, is made from it).
+    ///
+    /// Between two nodes each is read at the same chord relative to its own radius, r·κ/κ_k (the
+    /// same place on its ball: a 10 mm ball's antipode reads each node's antipode), not at the
+    /// same chord: a ratio grows steeply toward its ball's antipode, and read at one chord the
+    /// smaller node's antipode leaked into the larger ball's middle chords. Against a walk of the
+    /// ball itself between nodes (Skin1, R = 5 mm, κL = 0.74): 2.13 against 2.09 at a 4.75 mm
+    /// chord (2.27 read at one chord), 2.61 against 2.65 at 6.25 mm (3.08).
     pub fn ratio(&self, r_mm: f64, kappa: f64) -> f64 {
         if self.unit_mm.is_nan() || self.unit_mm <= 0.0 {
             return 1.0;
         }
-        let (rows, a_row, b_row, f) = self.rows_at(kappa);
-        let x = (r_mm / (r_mm + self.unit_mm) * ENTRIES as f64 - 0.5).clamp(0.0, (ENTRIES - 1) as f64);
-        let i = (x.floor() as usize).min(ENTRIES - 2);
+        let (a_row, b_row, f) = self.nodes_at(kappa);
+        // r·|κ|: the chord in units of the ball's radius (NaN: flat).
+        let relative = if kappa.is_nan() { 0.0 } else { r_mm * kappa.abs() };
         let at = |row: Option<usize>| match row {
             None => 1.0,
-            Some(k) => {
-                let (a, b) = (rows[k][i], rows[k][i + 1]);
-                a + (b - a) * (x - i as f64)
-            }
+            Some(k) => self.node_ratio(kappa < 0.0, k, relative * self.unit_mm / node_curvature(k)),
         };
         at(a_row) + (at(b_row) - at(a_row)) * f
     }
 
-    /// The two rows of curvature `kappa` (None: the flat one) and the weight of the second.
-    fn rows_at(&self, kappa: f64) -> (&[[f64; ENTRIES]], Option<usize>, Option<usize>, f64) {
-        let rows = if kappa < 0.0 { &self.concave } else { &self.convex };
-        let (a, b, f) = self.nodes_at(kappa);
-        (rows, a, b, f)
+    /// Node `k`'s ratio (a cavity's where `concave`) at chord `r_mm`, linear between entries.
+    pub fn node_ratio(&self, concave: bool, k: usize, r_mm: f64) -> f64 {
+        let rows = if concave { &self.concave } else { &self.convex };
+        let x = (r_mm / (r_mm + self.unit_mm) * ENTRIES as f64 - 0.5).clamp(0.0, (ENTRIES - 1) as f64);
+        if x.is_nan() {
+            return 1.0;
+        }
+        let i = (x.floor() as usize).min(ENTRIES - 2);
+        let (a, b) = (rows[k][i], rows[k][i + 1]);
+        a + (b - a) * (x - i as f64)
     }
 
     /// The two nodes of curvature `kappa` (1/mm; see [`nodes_at`]).
@@ -500,11 +534,11 @@ mod tests {
         }
         let unit = 1.0;
         let radius = 1e6; // no fade
-        let r = ratios(&curved, &flat, &expected, radius, unit);
+        let r = ratios(&curved, &flat, &expected, &[1.0; ENTRIES], radius, unit);
         assert!((r[20] - 1.0).abs() < 1e-12, "paired where both walks counted");
         assert!((r[35] - 4.0).abs() < 1e-12, "the ball over the profile: {}", r[35]);
         assert!((r[45] - r[39]).abs() < 1e-12, "held past the ball's reach");
-        let held = ratios(&curved, &flat, &[0.0; ENTRIES], radius, unit);
+        let held = ratios(&curved, &flat, &[0.0; ENTRIES], &[1.0; ENTRIES], radius, unit);
         assert!((held[35] - r[29]).abs() < 1e-12, "without a profile: held at the last paired entry");
     }
 
