@@ -78,8 +78,10 @@ void main() {
             vec4 incident[3];
             float area;
             node_sigma(index, ni, xo, center, offset, power, incident, area);
-            sum += merged_source(center + offset, ni, power, incident, vec3(0.0), xo, no, true)
-                 + merged_source(center - offset, ni, power, incident, vec3(0.0), xo, no, true);
+            sum += merged_source(center + offset, ni, power, incident, vec3(0.0), xo, no,
+                                 sigma_point_curvature(center + offset, ni, offset, xo, no), true)
+                 + merged_source(center - offset, ni, power, incident, vec3(0.0), xo, no,
+                                 sigma_point_curvature(center - offset, ni, -offset, xo, no), true);
         }
     }
     // w: the luminance of the part from beyond a chord R√2 (far_light, the exit's rows).

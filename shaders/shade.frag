@@ -157,7 +157,7 @@ float near_correction(vec3 xi, vec3 ni, float area, vec3 xo, vec3 no, inout uint
     for (uint c = 0u; c < 3u; ++c) flux[c] = own_incident[c] * (v * area);
     // At the pixel's normal, as the plane integral has it: the pixel's lights refracted at ni
     // would make a different function (near a terminator, lights below ni's horizon).
-    near_sum -= merged_source(x, no, own_irradiance * (v * area), flux, vec3(0.0), xo, no, false);
+    near_sum -= merged_source(x, no, own_irradiance * (v * area), flux, vec3(0.0), xo, no, pixel_curvature_mm, false);
     return v;
 }
 
@@ -247,7 +247,7 @@ vec3 near_field(vec3 xo, vec3 no, out uint made) {
         for (uint a = 0u; a < angles; ++a) {
             float phi = (float(a) + 0.5) * (3.14159265359 / float(angles));
             vec3 xi = xo + (r / s) * (cos(phi) * t1 + sin(phi) * t2);
-            sum += merged_source(xi, no, e * area, flux, vec3(0.0), xo, no, false);
+            sum += merged_source(xi, no, e * area, flux, vec3(0.0), xo, no, pixel_curvature_mm, false);
         }
         made += angles;
     }
@@ -651,8 +651,10 @@ void main() {
             // node, reach or not).
             if (power == vec3(0.0)) continue;
             evaluations += 2u;
-            sum += merged_source(center + offset, ni, power, incident, vec3(0.0), xo, no, true)
-                 + merged_source(center - offset, ni, power, incident, vec3(0.0), xo, no, true);
+            sum += merged_source(center + offset, ni, power, incident, vec3(0.0), xo, no,
+                                 sigma_point_curvature(center + offset, ni, offset, xo, no), true)
+                 + merged_source(center - offset, ni, power, incident, vec3(0.0), xo, no,
+                                 sigma_point_curvature(center - offset, ni, -offset, xo, no), true);
         }
         visits += tile.z;
         // The tile's far sources (none where the tile has no far field: its sums are 0), summed
@@ -752,7 +754,8 @@ void main() {
                     // budget may stop that, and the node is then used whole without its share).
                     if (power == vec3(0.0)) continue;
                     ++evaluations;
-                    sum += merged_source(xi, ni, power, incident, vec3(0.0), xo, no, true);
+                    float kappa = sigma_point_curvature(xi, ni, evaluation != 0u ? -offset : offset, xo, no);
+                    sum += merged_source(xi, ni, power, incident, vec3(0.0), xo, no, kappa, true);
                 }
             }
         }

@@ -342,17 +342,11 @@ fn the_front_lit_sphere_at_its_pole_matches_the_walk() {
 const RINGS: usize = 18;
 
 /// One channel of a front-lit sphere of radius `r_mm`, ring by ring: the walk's exitance of two or
-/// more scatterings against the renderer's sum over the lit hemisphere at the ring's middle (each
-/// source's lean toward the exit, the ratio at the chord), each source's term multiplied by
-/// `incidence(cos θi, chord)` (1: the renderer's) and its lean's harmonic b(chord) replaced by
-/// `harmonic` when given. Returns per ring (model / walk, the walk's relative noise).
-fn rings(
-    m: &Medium,
-    ratios: &curvature_profile::CurvatureChannel,
-    r_mm: f64,
-    incidence: impl Fn(f64, f64) -> f64,
-    harmonic: Option<&dyn Fn(f64) -> f64>,
-) -> Vec<(f64, f64)> {
+/// more scatterings against a sum over the lit hemisphere's sources at the ring's middle of
+/// E cos θi Ft(θi) dA · `term(cos θi, chord, cos φ)`, φ the angle along the source's surface
+/// between its light's lean and the way to the exit (0 where either vanishes). Returns per ring
+/// (sum / walk, the walk's relative noise).
+fn ring_sums(m: &Medium, r_mm: f64, steps: usize, term: impl Fn(f64, f64, f64) -> f64) -> Vec<(f64, f64)> {
     let sigma_t = m.sigma_a + m.sigma_s * (1.0 - m.g);
     let radius = r_mm * sigma_t;
     let (mut weighted, mut counts) = ([0.0f64; RINGS], [0u64; RINGS]);
@@ -363,7 +357,6 @@ fn rings(
             counts[b] += 1;
         }
     });
-    let profile = McProfile::of(m);
     (0..RINGS)
         .map(|b| {
             let (a0, a1) = (b as f64 / RINGS as f64 * PI, (b + 1) as f64 / RINGS as f64 * PI);
@@ -371,16 +364,12 @@ fn rings(
             let truth = weighted[b] * (PI * r_mm * r_mm / photons as f64) / area;
             let a = 0.5 * (a0 + a1);
             let xo = r_mm * DVec3::new(a.sin(), 0.0, a.cos());
-            let steps = 400;
             let mut model = 0.0;
             for k in 0..steps {
                 let theta = (k as f64 + 0.5) / steps as f64 * PI / 2.0;
                 let cos_i = theta.cos();
-                let cos_t = (1.0 - (1.0 - cos_i * cos_i) / (m.eta * m.eta)).max(0.0).sqrt();
-                let sin_t = (1.0 - cos_t * cos_t).sqrt();
                 let w = cos_i
                     * fresnel::transmittance(m.eta, cos_i)
-                    * profile.incidence_factor(cos_t)
                     * r_mm
                     * r_mm
                     * theta.sin()
@@ -390,7 +379,6 @@ fn rings(
                     let ph = (q as f64 + 0.5) / steps as f64 * 2.0 * PI;
                     let n = DVec3::new(theta.sin() * ph.cos(), theta.sin() * ph.sin(), theta.cos());
                     let d = xo - r_mm * n;
-                    let chord = d.length();
                     // The source's lean: its light's direction along the surface against the way
                     // to the exit (the merged records' m·d̂).
                     let (ahead, along) = (DVec3::new(0.0, 0.0, -1.0) + cos_i * n, d - d.dot(n) * n);
@@ -399,15 +387,36 @@ fn rings(
                     } else {
                         0.0
                     };
-                    let b: f64 = harmonic.map_or_else(|| profile.azimuth_factor(chord), |h| h(chord));
-                    let lean = (1.0 + b * sin_t * cos_phi).max(0.0);
-                    model +=
-                        w * profile.exitance(chord) * lean * ratios.ratio(chord, 1.0 / r_mm) * incidence(cos_i, chord);
+                    model += w * term(cos_i, d.length(), cos_phi);
                 }
             }
             (model / truth, 1.0 / (counts[b].max(1) as f64).sqrt())
         })
         .collect()
+}
+
+/// [`ring_sums`] of the renderer's term (each source's half-space profile at the chord, its
+/// incidence factor, its lean, the ratio at the chord), multiplied by `incidence(cos θi, chord)`
+/// (1: the renderer's) and with its lean's harmonic b(chord) replaced by `harmonic` when given.
+fn rings(
+    m: &Medium,
+    ratios: &curvature_profile::CurvatureChannel,
+    r_mm: f64,
+    incidence: impl Fn(f64, f64) -> f64,
+    harmonic: Option<&dyn Fn(f64) -> f64>,
+) -> Vec<(f64, f64)> {
+    let profile = McProfile::of(m);
+    ring_sums(m, r_mm, 400, |cos_i, chord, cos_phi| {
+        let cos_t = (1.0 - (1.0 - cos_i * cos_i) / (m.eta * m.eta)).max(0.0).sqrt();
+        let sin_t = (1.0 - cos_t * cos_t).sqrt();
+        let b: f64 = harmonic.map_or_else(|| profile.azimuth_factor(chord), |h| h(chord));
+        let lean = (1.0 + b * sin_t * cos_phi).max(0.0);
+        profile.incidence_factor(cos_t)
+            * profile.exitance(chord)
+            * lean
+            * ratios.ratio(chord, 1.0 / r_mm)
+            * incidence(cos_i, chord)
+    })
 }
 
 /// A 10 mm Marble sphere lit from the front, ring by ring from the pole to the silhouette: the
@@ -660,57 +669,20 @@ fn the_ball_s_own_oblique_beams_sum_to_the_walk() {
                     .collect()
             })
             .collect();
-        let mut weighted = [0.0f64; RINGS];
-        let walked = front_lit_walk(&m, r_mm, (400, 800), |ft, e| {
-            let b = ((e.geodesic / radius) / PI * RINGS as f64) as usize;
-            if e.scatterings >= 2 && b < RINGS {
-                weighted[b] += ft;
-            }
-        });
         let sum = |table: &Vec<Vec<[f64; AZIMUTHS]>>| -> Vec<f64> {
-            (0..RINGS)
-                .map(|b| {
-                    let (a0, a1) = (b as f64 / RINGS as f64 * PI, (b + 1) as f64 / RINGS as f64 * PI);
-                    let area = 2.0 * PI * r_mm * r_mm * (a0.cos() - a1.cos());
-                    let truth = weighted[b] * (PI * r_mm * r_mm / walked as f64) / area;
-                    let a = 0.5 * (a0 + a1);
-                    let xo = r_mm * DVec3::new(a.sin(), 0.0, a.cos());
-                    let steps = 300;
-                    let mut model = 0.0;
-                    for k in 0..steps {
-                        let theta = (k as f64 + 0.5) / steps as f64 * PI / 2.0;
-                        let cos_i = theta.cos();
-                        let w = cos_i
-                            * fresnel::transmittance(m.eta, cos_i)
-                            * r_mm
-                            * r_mm
-                            * theta.sin()
-                            * (PI / 2.0 / steps as f64)
-                            * (2.0 * PI / steps as f64);
-                        let j = cos_at.iter().position(|&x| x <= cos_i).unwrap_or(cos_at.len() - 1).max(1);
-                        let wj = ((cos_at[j - 1] - cos_i) / (cos_at[j - 1] - cos_at[j])).clamp(0.0, 1.0);
-                        for q in 0..steps {
-                            let ph = (q as f64 + 0.5) / steps as f64 * 2.0 * PI;
-                            let n = DVec3::new(theta.sin() * ph.cos(), theta.sin() * ph.sin(), theta.cos());
-                            let d = xo - r_mm * n;
-                            let k = (d.length() / (2.0 * r_mm) * chords as f64) as usize;
-                            if k >= chords {
-                                continue;
-                            }
-                            let (ahead, along) = (DVec3::new(0.0, 0.0, -1.0) + cos_i * n, d - d.dot(n) * n);
-                            let cos_phi = if ahead.length() > 1e-9 && along.length() > 1e-9 {
-                                ahead.normalize().dot(along.normalize())
-                            } else {
-                                1.0
-                            };
-                            let qq =
-                                ((cos_phi.clamp(-1.0, 1.0).acos() / PI * AZIMUTHS as f64) as usize).min(AZIMUTHS - 1);
-                            model += w * ((1.0 - wj) * table[j - 1][k][qq] + wj * table[j][k][qq]);
-                        }
-                    }
-                    model / truth
-                })
-                .collect()
+            ring_sums(&m, r_mm, 300, |cos_i, chord, cos_phi| {
+                let k = (chord / (2.0 * r_mm) * chords as f64) as usize;
+                if k >= chords {
+                    return 0.0;
+                }
+                let j = cos_at.iter().position(|&x| x <= cos_i).unwrap_or(cos_at.len() - 1).max(1);
+                let wj = ((cos_at[j - 1] - cos_i) / (cos_at[j - 1] - cos_at[j])).clamp(0.0, 1.0);
+                let q = ((cos_phi.clamp(-1.0, 1.0).acos() / PI * AZIMUTHS as f64) as usize).min(AZIMUTHS - 1);
+                (1.0 - wj) * table[j - 1][k][q] + wj * table[j][k][q]
+            })
+            .into_iter()
+            .map(|(ratio, _)| ratio)
+            .collect()
         };
         let (full, cut) = (sum(&tables), sum(&first_harmonic));
         let mut line = format!("{material} channel {c}, the ball's beams / walk (cut to the first harmonic):");

@@ -167,7 +167,8 @@ vec3 slab_exit_factor(usamplerBuffer table, vec4 header, float t, float cos_o) {
 // channel the ratios of nodes j − 1 (−1: flat, 1) and j (κ_j L = 2^(j + first)) at the same s
 // (each node read at the same place on its own ball) as two f16. `curvature_rows` (once per
 // pixel): the row of κ (1/mm) and the weight of its upper node, linear in κ from flat to node 0
-// and in log κ between nodes, held past the last; z = |κ|, w = L (0 and x = −1: no ratios).
+// and in log κ between nodes, held past the last; z = |κ| (the last node's past it), w = L (0 and
+// x = −1: no ratios).
 // `curvature_ratio` (per pair): one fetch, the nearest entry.
 const int CURVATURE_BASE = SLAB_BASE + 1 + int(SLAB_LOOKUP_NODES * SLAB_ENTRIES + SLAB_THICKNESS_NODES * MC_EXIT_BINS);
 const float CURVATURE_FIRST_LOG2 = float(CURVATURE_FIRST_LOG2_PLUS_8) - 8.0;
@@ -185,7 +186,9 @@ vec4 curvature_rows_at(float unit_mm, float kappa) {
     if (x < first) return vec4(side, x / first, x / unit_mm, unit_mm);
     float k = min(log2(x) - CURVATURE_FIRST_LOG2, float(CURVATURE_NODES - 1u));
     float i = min(floor(k), float(CURVATURE_NODES - 2u));
-    return vec4(side + i + 1.0, k - i, x / unit_mm, unit_mm);
+    // Past the last node its row is read at its own r·κ (mirrors CurvatureChannel::ratio).
+    float held = min(x, exp2(CURVATURE_FIRST_LOG2 + float(CURVATURE_NODES - 1u)));
+    return vec4(side + i + 1.0, k - i, held / unit_mm, unit_mm);
 }
 vec3 curvature_ratio(usamplerBuffer table, vec4 rows, float r_mm) {
     if (rows.x < 0.0) return vec3(1.0);

@@ -468,7 +468,7 @@ impl CurvatureRatios {
             return [1.0; 3];
         }
         let nodes = if kappa < 0.0 { &self.concave } else { &self.convex };
-        let s = if kappa.is_nan() { 0.0 } else { r_mm * kappa.abs() };
+        let s = if kappa.is_nan() { 0.0 } else { r_mm * kappa.abs().min(curvature_profile::last_curvature(unit)) };
         let e = ((s / (s + 1.0) * CURVATURE_TABLE_ENTRIES as f64) as usize).min(CURVATURE_TABLE_ENTRIES - 1);
         [0, 1, 2].map(|c| self.between_nodes(nodes, kappa, e, c))
     }

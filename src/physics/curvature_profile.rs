@@ -76,6 +76,11 @@ pub fn node_curvature(k: usize) -> f64 {
     2f64.powi(k as i32 + FIRST_CURVATURE_LOG2)
 }
 
+/// The last node's curvature (1/mm) for L = `unit_mm`: past it a row is read as at it.
+pub fn last_curvature(unit_mm: f64) -> f64 {
+    node_curvature(CURVATURE_NODES - 1) / unit_mm
+}
+
 /// The two nodes of curvature κL = `kappa_l` (None: the flat surface) and the weight of the
 /// second: linear in κ from flat to node 0, in log κ between nodes, held past the last; NaN
 /// reads as flat. The shade pass's `curvature_rows` and the GPU table's mirror read the same.
@@ -461,8 +466,10 @@ impl CurvatureChannel {
             return 1.0;
         }
         let (a_row, b_row, f) = self.nodes_at(kappa);
-        // r·|κ|: the chord in units of the ball's radius (NaN: flat).
-        let relative = if kappa.is_nan() { 0.0 } else { r_mm * kappa.abs() };
+        // r·|κ|: the chord in units of the ball's radius (NaN: flat); past the last node, whose
+        // row is held, its own (a pair across a box's edge reads a curvature of no ball there,
+        // and read at r·κ it took the smallest ball's antipode: 2-10 times the half-space).
+        let relative = if kappa.is_nan() { 0.0 } else { r_mm * kappa.abs().min(last_curvature(self.unit_mm)) };
         let at = |row: Option<usize>| match row {
             None => 1.0,
             Some(k) => self.node_ratio(kappa < 0.0, k, relative * self.unit_mm / node_curvature(k)),
