@@ -350,6 +350,14 @@ bool entry_surface(vec2 uv, uint layer, mat4 unproject, vec3 toward, out vec3 po
     return true;
 }
 
+// How far the shadow pass's slope-scaled depth bias (1.5 texels of depth slope, texels
+// normal_offset / 2 wide) moved the surface the map sees away from the light, along it:
+// about 0.75 normal_offset · tan θl, with tan θl held at `max_tan`.
+float shadow_bias_distance(float cos_l, float max_tan) {
+    float tan_l = min(sqrt(max(1.0 - cos_l * cos_l, 0.0)) / max(cos_l, 1e-3), max_tan);
+    return 0.75 * light_set.normal_offset * tan_l;
+}
+
 // Where light toward `toward` that reaches x inside entered (SS_ENTRY_STEPS refinements): from
 // the surface the map sees straight toward the light (y, normal n), the light refracted through
 // y's tangent plane reaches x from the point y* = x − t·h/cos θt of that plane (h: x's depth
@@ -373,11 +381,7 @@ bool light_entry(vec3 x, vec2 uv, uint layer, mat4 unproject, vec3 toward, float
     vec3 entry, t;
     for (int step = 0; step <= SS_ENTRY_STEPS; ++step) {
         cos_l = clamp(dot(n, toward), 0.0, 1.0);
-        // The shadow pass's slope-scaled depth bias (1.5 texels of depth slope, texels
-        // normal_offset / 2 wide) moved the surface away from the light by about
-        // 0.75 normal_offset · tan θl: put it back.
-        float tan_l = sqrt(max(1.0 - cos_l * cos_l, 0.0)) / max(cos_l, 1e-3);
-        entry = y + toward * (0.75 * light_set.normal_offset * tan_l);
+        entry = y + toward * shadow_bias_distance(cos_l, 1e30); // the shadow pass's bias taken back
         h = max(dot(entry - x, n), 0.0);
         float cos_t = sqrt(max(1.0 - (1.0 - cos_l * cos_l) / (eta * eta), 0.0));
         t = -(toward - cos_l * n) / eta - n * cos_t; // the refracted direction, inward
@@ -500,8 +504,7 @@ vec3 single_scattering(vec3 xo, vec3 no, vec3 wo) {
                     // The bias at this entry (its slope held at tan θl ≤ 8: the band a few
                     // texels, not the whole way to a grazing surface), for this sample's depth
                     // difference and the next ones'.
-                    float tan_l = min(sqrt(max(1.0 - cos_l * cos_l, 0.0)) / max(cos_l, 1e-3), 8.0);
-                    vec4 lifted = layer_matrix(layer) * vec4(x + toward * (0.75 * light_set.normal_offset * tan_l), 1.0);
+                    vec4 lifted = layer_matrix(layer) * vec4(x + toward * shadow_bias_distance(cos_l, 8.0), 1.0);
                     float bias = ndc.z - lifted.z / lifted.w;
                     d += bias - (layer == bias_layer ? depth_bias : 0.0);
                     depth_bias = bias;
