@@ -50,10 +50,15 @@ pub const ENTRIES: usize = 64;
 const TRANSMITTED: u64 = 20_000;
 const MAX_PHOTONS: u64 = 400_000;
 const MAX_SCATTERINGS: u64 = 3_000_000;
-/// A node that lets through less than this fraction of what enters (after NEGLIGIBLE_AFTER
-/// photons) ends the measurement: it and every thicker node hold 0 (thicker slabs let through
-/// less still, once past a mean free path; what they would add to a pixel is far below the
-/// half-space's own noise).
+/// A node past the peak of the transmission (at least a mean free path thick, and letting
+/// through less than the most any thinner node did) that lets through less than this fraction
+/// of what enters (after NEGLIGIBLE_AFTER photons) ends the measurement: it and every thicker
+/// node hold 0 (thicker slabs let through less still; what they would add to a pixel is far
+/// below the half-space's own noise). Before the peak it does not: light scattered twice or
+/// more grows with the thickness there (a thin slab scatters little), and where the albedo is
+/// low the first node is below this fraction and thicker ones are not: Ketchup's green and blue
+/// had ended at the first node, no light across at all (its 2 mm slab lit from behind: green
+/// 0.937 of the path tracer, all of it single scattering).
 const NEGLIGIBLE: f64 = 1e-4;
 const NEGLIGIBLE_AFTER: u64 = 40_000;
 const BATCH: u64 = 5_000;
@@ -171,14 +176,19 @@ impl SlabChannel {
         let albedo = sigma_s_reduced / sigma_t;
         let exit_norm = super::beam_diffusion::exit_normalisation(m.eta);
         let entry_start = glam::DVec3::new(0.0, 0.0, -1.0);
+        let mut peak = 0.0f64; // the largest fraction let through so far
         for k in 0..THICKNESS_NODES {
             let thickness_mfp = node_thickness(k) * unit_mm * sigma_t;
             let reach = reach_mm(unit_mm, k);
             let mut counts = [0u64; ENTRIES];
             let mut exit_counts = [0u64; EXIT_BINS];
             let (mut traced, mut through, mut scatterings) = (0u64, 0u64, 0u64);
-            let negligible =
-                |through: u64, traced: u64| traced >= NEGLIGIBLE_AFTER && (through as f64) < NEGLIGIBLE * traced as f64;
+            let negligible = |through: u64, traced: u64| {
+                traced >= NEGLIGIBLE_AFTER
+                    && (through as f64) < NEGLIGIBLE * traced as f64
+                    && thickness_mfp >= 1.0
+                    && (through as f64) < peak * traced as f64
+            };
             while through < TRANSMITTED
                 && traced < MAX_PHOTONS
                 && scatterings < MAX_SCATTERINGS
@@ -201,6 +211,7 @@ impl SlabChannel {
                 break;
             }
             let fraction = through as f64 / traced as f64;
+            peak = peak.max(fraction);
             out.transmitted[k] = fraction;
             for (i, sd) in out.sd[k].iter_mut().enumerate() {
                 let (r0, r1) =
