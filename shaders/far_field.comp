@@ -35,6 +35,7 @@ layout(push_constant) uniform FarFieldConstants {
     uvec2 tiles;  // 8x8 tiles across and down
     uint object;  // the object whose pixels and tree these are
     uint pad;
+    vec4 eye;     // the camera's position (xyz): the exit's tilt toward it
 } pc;
 
 #include "sources.glsl"
@@ -59,6 +60,11 @@ void main() {
         // centre), so that the sixteen sums are of one function.
         vec3 centre = imageLoad(surface_position, origin + ivec2(int(FAR_FIELD_TILE) / 2)).xyz;
         begin_sources(normal_curvature);
+        if (MODEL == MODEL_MC) {
+            vec3 wo = normalize(pc.eye.xyz - xo);
+            exit_along = wo - dot(wo, no) * no;
+            exit_normal = no;
+        }
         uint entry = header.x;
         for (uint e = 0u; e < header.y; ++e) {
             uint index = tile_entry(entry + e);

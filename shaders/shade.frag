@@ -223,10 +223,16 @@ vec3 near_field(vec3 xo, vec3 no, out uint made) {
         ? normalize(tangential)
         : normalize(cross(no, abs(no.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0)));
     vec3 t2 = cross(no, t1);
-    // The tables are radial but for the Monte Carlo table's lean (1 + b cos φ), whose cos φ
-    // integrates to 0 over the circle: its one angle at φ = π/2 from the lights' direction
-    // (cos φ = 0) is exact.
-    uint angles = MODEL == MODEL_DIRECTIONAL ? NEAR_ANGLES : 1u;
+    // The directional dipole: NEAR_ANGLES angles on the half circle, each standing for its
+    // mirror image. The Monte Carlo table: its lean (1 + b cos φ) times the exit's tilt toward
+    // the eye (1 + c cos(φ − φe) + ...), whose product has a second harmonic and no mirror
+    // symmetry (the eye's way along the surface is any): NEAR_ANGLES angles evenly over the
+    // whole circle, exact for harmonics up to the third. (One angle at φ = π/2 with the
+    // product's mean, (b c/2) ωt·m, left the clamp at zero out where the eye grazes: on the
+    // convergence test's back-lit Skin1 sphere the near field's blue 0.58% from the reference,
+    // against 0.37% before the tilt.)
+    uint angles = NEAR_ANGLES;
+    float arc = MODEL == MODEL_DIRECTIONAL ? 3.14159265359 : 6.28318530718;
     float t_end = asinh(start / scale);
     vec3 sum = vec3(0.0);
     for (uint j = 0u; j < 10u; ++j) {
@@ -245,7 +251,7 @@ vec3 near_field(vec3 xo, vec3 no, out uint made) {
         vec4 flux[3];
         for (uint c = 0u; c < 3u; ++c) flux[c] = incident[c] * area;
         for (uint a = 0u; a < angles; ++a) {
-            float phi = (float(a) + 0.5) * (3.14159265359 / float(angles));
+            float phi = (float(a) + 0.5) * (arc / float(angles));
             vec3 xi = xo + (r / s) * (cos(phi) * t1 + sin(phi) * t2);
             sum += merged_source(xi, no, e * area, flux, vec3(0.0), xo, no, pixel_curvature_mm, false);
         }
@@ -589,6 +595,10 @@ void main() {
     own_weight = imageLoad(surface_albedo, pixel).rgb;
     begin_sources(normal_curvature);
     vec3 wo = normalize(pc.eye.xyz - xo);
+    if (MODEL == MODEL_MC) {
+        exit_along = wo - dot(wo, no) * no;
+        exit_normal = no;
+    }
     vec3 sum = vec3(0.0);
     uint visits = 0u;
     uint evaluated = 0u;

@@ -696,7 +696,8 @@ impl Renderer {
                             position: &t.position,
                             normal: &t.normal,
                         };
-                        self.passes.far_field.record(rec, variant, &inputs, &self.tile_lists[k], k as u32)
+                        let eye = desc.camera.eye.extend(1.0).to_array();
+                        self.passes.far_field.record(rec, variant, &inputs, &self.tile_lists[k], (k as u32, eye))
                     })
                 })
             })?;

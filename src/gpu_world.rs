@@ -541,7 +541,7 @@ fn write_params(params: &mut Buffer, table: &mut Buffer, from: &MadeFrom, point_
             });
             let sd_table = SdTable::monte_carlo(&profiles, &[0, 1, 2].map(constants));
             let factors = AngularFactors::monte_carlo(&profiles);
-            (sd_table, factors, SlabTransmission::monte_carlo(&slabs), CurvatureRatios::monte_carlo(&curved))
+            (sd_table, factors, SlabTransmission::monte_carlo(&slabs), CurvatureRatios::monte_carlo(&curved, &profiles))
         }
     };
     table.write(0, &sd_table.texels())?;

@@ -130,6 +130,13 @@ fn default_images_converge_on_a_sphere() {
         // exact on a ball), which no near field can remove. So the near field's gain is held
         // where the points' error is (blue, the worst without it: `BLUE_GAIN`); red and green
         // to the 1%, and the worst no worse than without.
+        // With the exit's tilt (2026-12-06) 0.75 / 0.62 / 0.48% against 0.75 / 0.72 / 1.11%
+        // without the near field: the tilt's radial term times the irradiance's gradient around
+        // the pixel (light leaving away from the brighter side) has a mean the points sample and
+        // the variate, lit by the pixel's own irradiance alone, cannot take (brute force over the
+        // 11,150 points with the near field 0.26 / 0.30 / 0.43%, was 0.24 / 0.28 / 0.33%; eight
+        // angles in the disk instead of four: 0.43%). So blue's gain is held at 0.5, not 0.4.
+        // (0.77 / 0.58 / 0.37% before the tilt.)
         // (0.61 / 0.37 / 0.34% before each node was read at the same place on its ball; the
         // sigma points then kept the node's normal, 0.65 / 0.81 / 0.49%: see sources.glsl
         // sigma_point_curvature.)
@@ -142,7 +149,7 @@ fn default_images_converge_on_a_sphere() {
         let errors = case("sphere", model, &reference);
         check(&format!("sphere, {model:?}"), errors, bound, gain);
         if model == Model::Mc {
-            const BLUE_GAIN: f64 = 0.4;
+            const BLUE_GAIN: f64 = 0.5;
             let (with, without) = errors;
             assert!(
                 with[2] <= BLUE_GAIN * without[2],

@@ -10,6 +10,9 @@
 //! - each pair's curvature along its way (`pair_curvature`), at which the shade pass reads the
 //!   ratio: exact on spheres, cavities, planes and cylinders.
 
+mod common;
+
+use common::front_lit_walk;
 use glam::DVec3;
 use std::f64::consts::PI;
 use translucent::gpu::sd_table::{self, CurvatureRatios};
@@ -121,7 +124,7 @@ fn a_ball_returns_more_a_cavity_less_and_flat_is_one() {
 fn the_gpu_table_reads_the_ratios() {
     let media = skin1();
     let channels = curvature_profile::of_channels(&media);
-    let table = CurvatureRatios::monte_carlo(&channels);
+    let table = CurvatureRatios::monte_carlo(&channels, &McProfile::of_channels(&media));
     let unit = table.unit_mm as f64;
     let mut worst = 0.0f64;
     for kappa_l in [0.03, 0.2, 0.73, 1.5, 3.0, -0.3, -1.2] {
@@ -239,37 +242,6 @@ fn between_nodes_the_ratio_reads_each_ball_at_the_same_place() {
             assert!((ratio - 1.0).abs() < bound, "channel {c}, ring {k}: {ratio:.3} of the ball's walk");
         }
     }
-}
-
-/// Light along −z on a sphere of radius `r_mm` (centre (0, 0, −R) in mean free paths, the pole at
-/// the origin), walked exactly: photons on a stratified grid of `discs` × `angles` over the
-/// sphere's disc (equal areas: ring k's radius ∝ √((k + ½)/discs)), each entering refracted and
-/// weighted by its Fresnel transmittance; `on_escape(weight, escape)` for each escape. Returns the
-/// photons traced (each stands for πR²/photons of the disc).
-fn front_lit_walk(
-    m: &Medium,
-    r_mm: f64,
-    (discs, angles): (u64, u64),
-    mut on_escape: impl FnMut(f64, &sphere::SphereEscape),
-) -> u64 {
-    let sigma_t = m.sigma_a + m.sigma_s * (1.0 - m.g);
-    let (albedo, radius) = (m.sigma_s * (1.0 - m.g) / sigma_t, r_mm * sigma_t);
-    let centre = DVec3::new(0.0, 0.0, -radius);
-    let photons = discs * angles;
-    for i in 0..photons {
-        let (k, j) = (i / angles, i % angles);
-        let rho = radius * ((k as f64 + 0.5) / discs as f64).sqrt();
-        let phi = 2.0 * PI * (j as f64 + 0.5 * (k % 2) as f64) / angles as f64;
-        let p = DVec3::new(rho * phi.cos(), rho * phi.sin(), -radius + (radius * radius - rho * rho).max(0.0).sqrt());
-        let n = (p - centre) / radius;
-        let cos_i = n.z.clamp(0.0, 1.0);
-        let ft = fresnel::transmittance(m.eta, cos_i);
-        let cos_t = (1.0 - (1.0 - cos_i * cos_i) / (m.eta * m.eta)).max(0.0).sqrt();
-        let t = ((DVec3::new(0.0, 0.0, -1.0) + cos_i * n) / m.eta - cos_t * n).normalize();
-        let seed = 0x1234_5678 ^ i.wrapping_mul(0x9E37_79B9_7F4A_7C15);
-        sphere::trace_from((albedo, m.eta, radius), p, t, (seed, 100_000), |e| on_escape(ft, e));
-    }
-    photons
 }
 
 /// A 10 mm Skin1 sphere under light along −z, by the walk: the exitance of two or more

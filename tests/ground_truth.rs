@@ -68,6 +68,15 @@ fn ketchup_thin_slab_against_the_path_tracer() {
 /// selection moves a back-lit mean by 4%). Each case is held to its measured ratio within 4%
 /// so that it fails if the model moves either way: a fix of a
 /// deficit updates the numbers here, with its cause.
+/// - **The exit's tilt** (2026-12-06, `McProfile::exit_tilt`, tests/exit_tilt.rs): light leaves
+///   leaning away from where it entered, which took every curved case to the numbers in the
+///   test (the Skin1 sphere front-lit 1.042 1.030 1.017 → 0.980 0.979 0.985, back-lit 0.960
+///   0.833 0.804 → 1.052 0.964 0.923; the box 1.179 1.064 0.971 → 1.150 1.045 0.967; the torus
+///   1.045 1.040 1.035 → 0.992 0.988 0.999 and 1.038 0.964 0.926 → 1.075 1.023 0.988; the
+///   bunnies 0.969 0.823 0.781 → 1.037 0.901 0.846 and 0.999 0.977 0.930 → 1.035 1.013 0.967;
+///   Potato 1.056 1.059 1.039 → 0.994 0.998 0.973 and 0.959 0.964 0.929 → 1.032 1.046 1.041,
+///   Marble 1.032 1.026 1.020 → 1.007 1.003 1.001 and 0.943 0.959 0.951 → 1.002 1.020 1.014,
+///   brute force). The history below is of the numbers before it.
 /// - The 10 mm Skin1 sphere: the curvature ratios and the oblique entry's harmonic
 ///   (src/physics/curvature_profile.rs, mc_profile.rs) take the front-lit one to 1.042 1.030
 ///   1.017, where the flat half-space's profile gave 0.88 0.90 0.93 (1.070 1.052 1.029 when the
@@ -125,17 +134,17 @@ fn ketchup_thin_slab_against_the_path_tracer() {
 fn curved_objects_against_the_path_tracer() {
     let brute = ["--brute-force", "--samples", "100000"];
     let cases: [(&str, &[&str], [f64; 3]); 11] = [
-        ("skin1/sphere-front", &brute, [1.042, 1.030, 1.017]),
-        ("skin1/sphere-back", &brute, [0.960, 0.833, 0.804]),
-        ("skin1/box-back", &brute, [1.179, 1.064, 0.971]),
-        ("skin1/torus-front", &brute, [1.045, 1.040, 1.035]),
-        ("skin1/torus-back", &brute, [1.038, 0.964, 0.926]),
-        ("skin1/bunny", &[], [0.969, 0.823, 0.781]),
-        ("marble/bunny", &[], [0.999, 0.977, 0.930]),
-        ("potato/sphere-front", &[], [1.056, 1.059, 1.039]),
-        ("marble/sphere-front", &[], [1.032, 1.026, 1.020]),
-        ("potato/sphere-back", &[], [0.959, 0.964, 0.929]),
-        ("marble/sphere-back", &[], [0.943, 0.959, 0.951]),
+        ("skin1/sphere-front", &brute, [0.980, 0.979, 0.985]),
+        ("skin1/sphere-back", &brute, [1.052, 0.964, 0.923]),
+        ("skin1/box-back", &brute, [1.150, 1.045, 0.967]),
+        ("skin1/torus-front", &brute, [0.992, 0.988, 0.999]),
+        ("skin1/torus-back", &brute, [1.075, 1.023, 0.988]),
+        ("skin1/bunny", &[], [1.037, 0.901, 0.846]),
+        ("marble/bunny", &[], [1.035, 1.013, 0.967]),
+        ("potato/sphere-front", &[], [0.994, 0.998, 0.973]),
+        ("marble/sphere-front", &[], [1.007, 1.003, 1.001]),
+        ("potato/sphere-back", &[], [1.032, 1.046, 1.041]),
+        ("marble/sphere-back", &[], [1.002, 1.020, 1.014]),
     ];
     for (name, sampling, expected) in cases {
         for (ch, ratio) in mc_against_its_reference(name, sampling).into_iter().enumerate() {

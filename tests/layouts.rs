@@ -203,6 +203,7 @@ fn push_constants_match_glsl() {
         offset_of!(FarFieldConstants, tiles),
         offset_of!(FarFieldConstants, object),
         offset_of!(FarFieldConstants, pad),
+        offset_of!(FarFieldConstants, eye),
     ];
     assert_eq!(offsets("far_field.comp", "FarFieldConstants"), far.map(|o| o as u32));
     // The surface pass, and the opaque objects' shading.

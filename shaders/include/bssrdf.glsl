@@ -219,6 +219,22 @@ vec3 curvature_exit(usamplerBuffer table, vec4 rows, float cos_o, float far) {
     return mix(mix(at[0], at[1], y - j), mix(at[2], at[3], y - j), far);
 }
 
+// The Monte Carlo table's exit tilt [c, g] per channel at distance r (mirrors
+// gpu::sd_table::CurvatureRatios::exit_tilt_at, physics::mc_profile::McProfile::exit_tilt_at):
+// after the curvature rows and the exit rows, EXIT_TILT_ENTRIES texels of f16 pairs (c_r, c_g),
+// (c_b, g_r), (g_g, g_b) at the centres of u = r/(r + L), the nearest read; `unit_mm` = L (0:
+// none, the other models).
+void exit_tilt(usamplerBuffer table, float unit_mm, float r_mm, out vec3 c, out vec3 g) {
+    c = g = vec3(0.0);
+    if (!(unit_mm > 0.0)) return;
+    int base = CURVATURE_BASE + 1 + 2 * int(CURVATURE_NODES * CURVATURE_TABLE_ENTRIES) + 4 * int(CURVATURE_NODES * MC_EXIT_BINS);
+    int e = min(int(r_mm / (r_mm + unit_mm) * float(EXIT_TILT_ENTRIES)), int(EXIT_TILT_ENTRIES) - 1);
+    uvec3 pairs = texelFetch(table, base + e).xyz;
+    vec2 a = unpackHalf2x16(pairs.x), b = unpackHalf2x16(pairs.y), d = unpackHalf2x16(pairs.z);
+    c = vec3(a.x, a.y, b.x);
+    g = vec3(b.y, d.x, d.y);
+}
+
 // The ray-source term S'(x, w, r) of the directional dipole.
 float dirpole_source(BssrdfChannel c, vec3 x, vec3 w, float r, vec3 no) {
     float s_r = c.sigma_tr * r;

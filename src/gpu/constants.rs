@@ -32,6 +32,8 @@ pub const SLAB_FIRST_NODE_LOG2_PLUS_8: u32 = 4;
 pub const CURVATURE_NODES: u32 = 8;
 pub const CURVATURE_FIRST_LOG2_PLUS_8: u32 = 4;
 pub const CURVATURE_TABLE_ENTRIES: u32 = 1024;
+/// Entries of the Monte Carlo table's exit tilt, after the curvature rows.
+pub const EXIT_TILT_ENTRIES: u32 = 256;
 
 /// Set in a tree node's child index when the child is a point (index into the sorted points).
 pub const LEAF_BIT: u32 = 0x8000_0000;
@@ -78,6 +80,7 @@ pub const GLSL_CONSTANTS: &[(&str, u32)] = &[
     ("SLAB_FIRST_NODE_LOG2_PLUS_8", SLAB_FIRST_NODE_LOG2_PLUS_8),
     ("CURVATURE_NODES", CURVATURE_NODES),
     ("CURVATURE_TABLE_ENTRIES", CURVATURE_TABLE_ENTRIES),
+    ("EXIT_TILT_ENTRIES", EXIT_TILT_ENTRIES),
     ("CURVATURE_FIRST_LOG2_PLUS_8", CURVATURE_FIRST_LOG2_PLUS_8),
     ("LEAF_BIT", LEAF_BIT),
     ("RADIX_TILE", RADIX_TILE),

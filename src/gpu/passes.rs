@@ -123,6 +123,8 @@ pub struct FarFieldConstants {
     /// The object whose pixels and tree the far field is of.
     pub object: u32,
     pub pad: u32,
+    /// The camera's position (xyz; w unused): the exit's tilt toward it.
+    pub eye: [f32; 4],
 }
 
 /// Push constants of shaders/tile_cut.comp.

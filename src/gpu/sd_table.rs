@@ -303,6 +303,8 @@ const _: () = assert!(curvature_profile::FIRST_CURVATURE_LOG2 + 8 == super::CURV
 /// Entries per row of [`CurvatureRatios`] (bssrdf.glsl reads the nearest: fine enough that
 /// rounding r moves a ratio by under 1%; tests/curvature_profile.rs).
 pub const CURVATURE_TABLE_ENTRIES: usize = super::CURVATURE_TABLE_ENTRIES as usize;
+/// Entries of [`CurvatureRatios`]'s exit tilt (bssrdf.glsl's `exit_tilt`).
+pub const EXIT_TILT_ENTRIES: usize = super::EXIT_TILT_ENTRIES as usize;
 
 /// The Monte Carlo table's curvature ratios, after the light across in the same buffer
 /// (bssrdf.glsl's `curvature_rows`, `curvature_ratio`; [`CurvatureChannel`], resampled at
@@ -314,7 +316,11 @@ pub const CURVATURE_TABLE_ENTRIES: usize = super::CURVATURE_TABLE_ENTRIES as usi
 /// each side (convex, then concave) row j holds nodes j − 1 and j, node −1 being the flat
 /// surface (every ratio 1). Then the exit distribution's ratios (`curvature_exit`;
 /// [`CurvatureChannel::exit_ratio`]): the same 2N rows of MC_EXIT_BINS texels, paired the same way,
-/// of the light from within a chord R√2, then 2N more of the light from beyond it.
+/// of the light from within a chord R√2, then 2N more of the light from beyond it. Then the
+/// Monte Carlo table's exit tilt [c, g] ([`McProfile::exit_tilt_at`]) at EXIT_TILT_ENTRIES
+/// centres of u = r/(r + L), one texel each: f16 pairs (c_r, c_g), (c_b, g_r), (g_g, g_b)
+/// (`exit_tilt`; it rides here, where L is read per pixel anyway, as the Sd table's texels have
+/// no word left).
 #[derive(Clone, Debug, PartialEq)]
 pub struct CurvatureRatios {
     pub unit_mm: f32,
@@ -326,6 +332,8 @@ pub struct CurvatureRatios {
     pub concave_exit: Vec<Vec<[f32; 3]>>,
     pub convex_exit_far: Vec<Vec<[f32; 3]>>,
     pub concave_exit_far: Vec<Vec<[f32; 3]>>,
+    /// Per entry, [c, g] per channel.
+    pub exit_tilt: Vec<[[f32; 3]; 2]>,
 }
 
 impl CurvatureRatios {
@@ -343,10 +351,15 @@ impl CurvatureRatios {
             concave_exit: flat_exit.clone(),
             convex_exit_far: flat_exit.clone(),
             concave_exit_far: flat_exit,
+            exit_tilt: vec![[[0.0; 3]; 2]; EXIT_TILT_ENTRIES],
         }
     }
 
-    pub fn monte_carlo(channels: &[std::sync::Arc<CurvatureChannel>; 3]) -> CurvatureRatios {
+    /// The ratios of `channels` and the exit tilt of `profiles` (the same medium's).
+    pub fn monte_carlo(
+        channels: &[std::sync::Arc<CurvatureChannel>; 3],
+        profiles: &[std::sync::Arc<McProfile>; 3],
+    ) -> CurvatureRatios {
         let unit = channels[0].unit_mm;
         let nodes = |sign: f64| -> Vec<Vec<[f32; 3]>> {
             (0..curvature_profile::CURVATURE_NODES)
@@ -393,7 +406,25 @@ impl CurvatureRatios {
             concave_exit: exits(true, false),
             convex_exit_far: exits(false, true),
             concave_exit_far: exits(true, true),
+            exit_tilt: (0..EXIT_TILT_ENTRIES)
+                .map(|i| {
+                    let u = (i as f64 + 0.5) / EXIT_TILT_ENTRIES as f64;
+                    let tilt = [0, 1, 2].map(|c| profiles[c].exit_tilt_at(unit * u / (1.0 - u)));
+                    [0, 1].map(|j| tilt.map(|t| t[j] as f32))
+                })
+                .collect(),
         }
+    }
+
+    /// The exit tilt [c, g] per channel at distance `r_mm`, as the shade pass reads it
+    /// (`exit_tilt`): the nearest entry, in f16; 0 without ratios.
+    pub fn exit_tilt_at(&self, r_mm: f64) -> [[f64; 3]; 2] {
+        let unit = self.unit_mm as f64;
+        if unit.is_nan() || unit <= 0.0 {
+            return [[0.0; 3]; 2];
+        }
+        let e = ((r_mm / (r_mm + unit) * EXIT_TILT_ENTRIES as f64) as usize).min(EXIT_TILT_ENTRIES - 1);
+        self.exit_tilt[e].map(|v| v.map(|x| half_value(half_bits(x))))
     }
 
     pub fn texels(&self) -> Vec<[u32; 4]> {
@@ -421,6 +452,10 @@ impl CurvatureRatios {
             .chain(side(&self.concave_exit, mc_profile::EXIT_BINS))
             .chain(side(&self.convex_exit_far, mc_profile::EXIT_BINS))
             .chain(side(&self.concave_exit_far, mc_profile::EXIT_BINS))
+            .chain(self.exit_tilt.iter().map(|[c, g]| {
+                let pair = |a: f32, b: f32| half_bits(a) as u32 | (half_bits(b) as u32) << 16;
+                [pair(c[0], c[1]), pair(c[2], g[0]), pair(g[1], g[2]), 0]
+            }))
             .collect()
     }
 
@@ -474,7 +509,8 @@ impl CurvatureRatios {
     }
 
     /// Texels after the light across.
-    pub const TEXELS: usize = 1 + Self::ROWS * (CURVATURE_TABLE_ENTRIES + 2 * mc_profile::EXIT_BINS);
+    pub const TEXELS: usize =
+        1 + Self::ROWS * (CURVATURE_TABLE_ENTRIES + 2 * mc_profile::EXIT_BINS) + EXIT_TILT_ENTRIES;
 }
 
 /// Beam diffusion's entry at `r` of a table of `reach`: Sd, but at r = 0 the v0 for which the

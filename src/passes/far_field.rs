@@ -42,14 +42,15 @@ impl FarFieldPass {
         Ok(())
     }
 
-    /// The nine sums of every tile of `lists` (which must be of 8x8 tiles) for `object`.
+    /// The nine sums of every tile of `lists` (which must be of 8x8 tiles) for `object`, seen
+    /// from `eye` (the Monte Carlo table's exit tilt leans toward it).
     pub fn record(
         &self,
         rec: &mut Recorder,
         (model, one_light): (Model, bool),
         inputs: &FarFieldInputs,
         lists: &TileLists,
-        object: u32,
+        (object, eye): (u32, [f32; 4]),
     ) -> Result<()> {
         if lists.list_tile != FAR_FIELD_TILE {
             return Err(crate::runtime!(
@@ -62,7 +63,7 @@ impl FarFieldPass {
             .pipelines
             .get(&(model, one_light))
             .ok_or_else(|| crate::runtime!("far field: the pipeline of {model:?} was not prepared"))?;
-        let constants = FarFieldConstants { tiles: lists.tiles, object, pad: 0 };
+        let constants = FarFieldConstants { tiles: lists.tiles, object, pad: 0, eye };
         rec.dispatch(
             pipeline,
             &[

@@ -219,6 +219,8 @@ pub struct Escape {
     pub x: f64,
     pub y: f64,
     pub mu_o2: f64,
+    /// The direction outside along the face (x, y): the inside one's, times η (Snell).
+    pub along: [f64; 2],
     pub scatterings: u32,
     pub transmitted: bool,
 }
@@ -277,7 +279,8 @@ pub fn trace_slab(
                     continue;
                 }
                 let mu_o2 = 1.0 - eta * eta * (1.0 - cos * cos);
-                on_escape(&Escape { x, y, mu_o2: mu_o2.clamp(0.0, 1.0), scatterings, transmitted: far });
+                let along = [eta * d.x, eta * d.y];
+                on_escape(&Escape { x, y, mu_o2: mu_o2.clamp(0.0, 1.0), along, scatterings, transmitted: far });
                 break;
             }
             x += s * d.x;

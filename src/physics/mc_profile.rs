@@ -118,6 +118,18 @@ pub struct McProfile {
     /// sphere lit from the front every source's light leans away from the pixel at the pole and
     /// toward the rim (physics::curvature_profile).
     pub azimuth: Vec<f64>,
+    /// Which way the light leaves (the exit's tilt), per radial bin of [`AZIMUTH_BINS`]: at
+    /// distance ρ from where light entered, the radiance leaving toward ωo (outside, its part
+    /// along the surface ωt, |ωt| = sin θo) is the azimuth-free one times
+    /// 1 + c(ρ) ωt·â + g(ρ) ωt·m, â the way along the surface away from the entry, m the
+    /// refracted beam's part along the surface (|m| = sin θt). Fitted by least squares over the
+    /// exits of two or more scatterings of every incidence node, [c, g] per bin. Light leaves
+    /// leaning away from where it entered (c 0.3-0.9: more so near the entry), and near an oblique
+    /// entry back toward the light (g < 0 within a mean free path). Nothing on a flat surface lit
+    /// evenly (â averages out, and g cancels c's share along the lean b); on a front-lit ball the
+    /// rim's light comes from the brighter pole and leaves leaning away from the eye, on a
+    /// back-lit one toward it (tests/exit_tilt.rs).
+    pub exit_tilt: Vec<[f64; 2]>,
 }
 
 impl super::table_cache::Flat for McProfile {
@@ -135,6 +147,7 @@ impl super::table_cache::Flat for McProfile {
         v.extend(self.exit.iter().flatten());
         super::table_cache::push_vec(&mut v, self.density.iter().copied());
         super::table_cache::push_vec(&mut v, self.azimuth.iter().copied());
+        super::table_cache::push_vec(&mut v, self.exit_tilt.concat().into_iter());
         v
     }
     fn from_flat(values: &[f64]) -> Option<McProfile> {
@@ -145,8 +158,12 @@ impl super::table_cache::Flat for McProfile {
         for row in &mut exit {
             *row = t.array::<EXIT_BINS>()?;
         }
-        let (density, azimuth) = (t.vec()?, t.vec()?);
+        let (density, azimuth, tilt) = (t.vec()?, t.vec()?, t.vec()?);
         t.end()?;
+        if tilt.len() % 2 != 0 {
+            return None;
+        }
+        let exit_tilt = tilt.chunks_exact(2).map(|p| [p[0], p[1]]).collect();
         Some(McProfile {
             sigma_t_reduced,
             albedo_reduced,
@@ -159,6 +176,7 @@ impl super::table_cache::Flat for McProfile {
             incidence,
             exit,
             azimuth,
+            exit_tilt,
         })
     }
 }
@@ -243,6 +261,68 @@ fn azimuth_harmonic(
         .collect()
 }
 
+/// Per azimuth bin, the exit tilt's least-squares sums over escapes: Σ|ωt|², Σ|ωt|² â·m,
+/// Σ|ωt|² |m|², Σ 2ωt·â, Σ 2ωt·m, and the count.
+type TiltSums = [[f64; 6]; AZIMUTH_BINS];
+
+/// Adds one escape at (x, y) leaving along `along` (outside) from an entry of tangential part
+/// `m` to `sums`.
+fn add_tilt(sums: &mut TiltSums, (x, y): (f64, f64), along: [f64; 2], m: f64) {
+    let rho = (x * x + y * y).sqrt();
+    let Some(b) = azimuth_bin_of(rho) else { return };
+    if rho <= 0.0 {
+        return;
+    }
+    let (ax, ay) = (x / rho, y / rho);
+    let s = along[0] * along[0] + along[1] * along[1];
+    let t = &mut sums[b];
+    t[0] += s;
+    t[1] += s * ax * m;
+    t[2] += s * m * m;
+    t[3] += 2.0 * (along[0] * ax + along[1] * ay);
+    t[4] += 2.0 * along[0] * m;
+    t[5] += 1.0;
+}
+
+/// [c, g] per bin from the nodes' pooled sums (each bin with its neighbours until
+/// AZIMUTH_MIN_COUNT escapes count); g = 0 where no oblique light reached the bin.
+fn exit_tilt(nodes: &[TiltSums]) -> Vec<[f64; 2]> {
+    let pooled: Vec<[f64; 6]> = (0..AZIMUTH_BINS)
+        .map(|b| {
+            let mut t = [0.0; 6];
+            for n in nodes {
+                (0..6).for_each(|i| t[i] += n[b][i]);
+            }
+            t
+        })
+        .collect();
+    (0..AZIMUTH_BINS)
+        .map(|b| {
+            let mut t = pooled[b];
+            let mut w = 1;
+            while t[5] < AZIMUTH_MIN_COUNT as f64 && w < AZIMUTH_BINS {
+                for j in [b.wrapping_sub(w), b + w] {
+                    if let Some(p) = pooled.get(j) {
+                        (0..6).for_each(|i| t[i] += p[i]);
+                    }
+                }
+                w += 1;
+            }
+            let [a, ab, bb, y1, y2, _] = t;
+            let det = a * bb - ab * ab;
+            let (c, g) = if det > 1e-9 * a * bb && det > 0.0 {
+                ((y1 * bb - y2 * ab) / det, (a * y2 - ab * y1) / det)
+            } else if a > 0.0 {
+                (y1 / a, 0.0)
+            } else {
+                (0.0, 0.0)
+            };
+            // As the lean b: held within ±2 (a bin of few, noisy escapes).
+            [c.clamp(-2.0, 2.0), g.clamp(-2.0, 2.0)]
+        })
+        .collect()
+}
+
 /// cos θt of incidence node `k`.
 pub fn incidence_node(cos_t_min: f64, k: usize) -> f64 {
     cos_t_min + (1.0 - cos_t_min) * k as f64 / (INCIDENCE_NODES - 1) as f64
@@ -291,6 +371,7 @@ impl McProfile {
         let node = |k: usize| {
             let (mut exit_counts, mut cos_phi) = ([0u64; EXIT_BINS], [(0.0f64, 0u64); AZIMUTH_BINS]);
             let (mut density, mut single) = (vec![0.0; RADIAL_BINS + 1], 0u64);
+            let mut tilt: TiltSums = [[0.0; 6]; AZIMUTH_BINS];
             let cos_t = incidence_node(cos_t_min, k);
             let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
             let start = glam::DVec3::new(sin_t, 0.0, -cos_t);
@@ -311,6 +392,7 @@ impl McProfile {
                             density[k] += 1.0;
                         }
                         exit_counts[exit_bin(e)] += 1;
+                        add_tilt(&mut tilt, (e.x, e.y), e.along, 0.0);
                     },
                 )
             } else {
@@ -328,11 +410,12 @@ impl McProfile {
                                 cos_phi[b].0 += e.x / rho;
                                 cos_phi[b].1 += 1;
                             }
+                            add_tilt(&mut tilt, (e.x, e.y), e.along, sin_t);
                         }
                     },
                 )
             };
-            ((traced, exit_counts), cos_phi, density, single)
+            ((traced, exit_counts), cos_phi, density, single, tilt)
         };
         let node = &node;
         let nodes: Vec<_> = std::thread::scope(|s| {
@@ -341,7 +424,8 @@ impl McProfile {
         });
         let runs: [(u64, [u64; EXIT_BINS]); INCIDENCE_NODES] = std::array::from_fn(|k| nodes[k].0);
         let harmonic: [[(f64, u64); AZIMUTH_BINS]; INCIDENCE_NODES] = std::array::from_fn(|k| nodes[k].1);
-        let (_, _, mut density, single) = nodes[INCIDENCE_NODES - 1].clone();
+        let tilts: Vec<TiltSums> = nodes.iter().map(|n| n.4).collect();
+        let (_, _, mut density, single, _) = nodes[INCIDENCE_NODES - 1].clone();
         let escape_of = |(traced, counts): &(u64, [u64; EXIT_BINS])| counts.iter().sum::<u64>() as f64 / *traced as f64;
         let (normal_traced, _) = runs[INCIDENCE_NODES - 1];
         for (k, d) in density.iter_mut().enumerate() {
@@ -381,6 +465,7 @@ impl McProfile {
         let azimuth = azimuth_harmonic(&harmonic, sin_t);
         let mut profile = McProfile {
             azimuth,
+            exit_tilt: exit_tilt(&tilts),
             sigma_t_reduced,
             albedo_reduced: albedo,
             eta,
@@ -465,6 +550,24 @@ impl McProfile {
         let i = (x.floor() as usize).min(AZIMUTH_BINS - 2);
         let f = (x - i as f64).clamp(0.0, 1.0);
         self.azimuth[i] + (self.azimuth[i + 1] - self.azimuth[i]) * f
+    }
+
+    /// The exit's tilt [c, g] at distance `r` (mm), read as [`McProfile::azimuth_factor`]
+    /// (0 for a profile without it).
+    pub fn exit_tilt_at(&self, r: f64) -> [f64; 2] {
+        if self.exit_tilt.len() < AZIMUTH_BINS {
+            return [0.0; 2];
+        }
+        let rho = r * self.sigma_t_reduced;
+        let x = if rho <= azimuth_bin_centre(1) {
+            return self.exit_tilt[if rho < AZIMUTH_MIN { 0 } else { 1 }];
+        } else {
+            (rho / AZIMUTH_MIN).log2() * AZIMUTH_PER_OCTAVE + 0.5
+        };
+        let i = (x.floor() as usize).min(AZIMUTH_BINS - 2);
+        let f = (x - i as f64).clamp(0.0, 1.0);
+        let (a, b) = (self.exit_tilt[i], self.exit_tilt[i + 1]);
+        [a[0] + (b[0] - a[0]) * f, a[1] + (b[1] - a[1]) * f]
     }
 
     /// f at refracted cosine `cos_t`, linear between nodes.

@@ -193,3 +193,35 @@ pub fn box_obj(half: f32, thickness: f32, uv: bool) -> String {
     }
     obj
 }
+
+/// Light along −z on a sphere of radius `r_mm` (centre (0, 0, −R) in mean free paths, the pole at
+/// the origin), walked exactly: photons on a stratified grid of `discs` × `angles` over the
+/// sphere's disc (equal areas: ring k's radius ∝ √((k + ½)/discs)), each entering refracted and
+/// weighted by its Fresnel transmittance; `on_escape(weight, escape)` for each escape. Returns the
+/// photons traced (each stands for πR²/photons of the disc).
+pub fn front_lit_walk(
+    m: &translucent::physics::Medium,
+    r_mm: f64,
+    (discs, angles): (u64, u64),
+    mut on_escape: impl FnMut(f64, &translucent::physics::sphere::SphereEscape),
+) -> u64 {
+    let sigma_t = m.sigma_a + m.sigma_s * (1.0 - m.g);
+    let (albedo, radius) = (m.sigma_s * (1.0 - m.g) / sigma_t, r_mm * sigma_t);
+    let centre = glam::DVec3::new(0.0, 0.0, -radius);
+    let photons = discs * angles;
+    for i in 0..photons {
+        let (k, j) = (i / angles, i % angles);
+        let rho = radius * ((k as f64 + 0.5) / discs as f64).sqrt();
+        let phi = 2.0 * std::f64::consts::PI * (j as f64 + 0.5 * (k % 2) as f64) / angles as f64;
+        let p =
+            glam::DVec3::new(rho * phi.cos(), rho * phi.sin(), -radius + (radius * radius - rho * rho).max(0.0).sqrt());
+        let n = (p - centre) / radius;
+        let cos_i = n.z.clamp(0.0, 1.0);
+        let ft = translucent::physics::fresnel::transmittance(m.eta, cos_i);
+        let cos_t = (1.0 - (1.0 - cos_i * cos_i) / (m.eta * m.eta)).max(0.0).sqrt();
+        let t = ((glam::DVec3::new(0.0, 0.0, -1.0) + cos_i * n) / m.eta - cos_t * n).normalize();
+        let seed = 0x1234_5678 ^ i.wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        translucent::physics::sphere::trace_from((albedo, m.eta, radius), p, t, (seed, 100_000), |e| on_escape(ft, e));
+    }
+    photons
+}
