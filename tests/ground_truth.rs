@@ -221,6 +221,34 @@ fn single_scattering_against_the_path_tracer() {
     }
 }
 
+/// Single scattering on the default Skin1 bunny (back-lit, 128 × 96, the default tree) against
+/// the path tracer limited to light scattered once (`skin1/bunny-single`, 8 × 4096 spp, noise of
+/// the mean 0.8 / 0.9 / 1.2%): measured 0.693 0.730 0.747, held there within 4%. This is a known
+/// deficit, not a goal met: it is most of what the whole bunny misses in green and blue (single
+/// scattering is 12 / 23 / 37% of the path tracer's light there; multiple scattering alone, the
+/// full reference less this one, is 1.084 0.952 0.904). What it is not (README, "The default
+/// bunny"): the mesh's interpolated normals (the reference with face normals: 1.8 / 3.1 / 1.7% more),
+/// the shadow map's resolution (8192²: 0.711 0.744 0.760), more entry steps (10: 0.710 0.743
+/// 0.755). What moves it: accepting every entry whatever its miss gives 1.125 1.062 0.998 (the
+/// body's lower half, in the shadow the bunny casts inside itself, then lit), four times the
+/// miss's tolerance 0.823 0.838 0.834. And 9 / 9 / 11% of the path tracer's light is in 6% of
+/// the pixels (the base of the right ear, around the front paws) where the renderer has a fifth
+/// of it, and under half even with every entry accepted.
+#[test]
+fn single_scattering_on_the_bunny_against_the_path_tracer() {
+    let name = "skin1/bunny-single";
+    let measured: Vec<f64> = case(name)["ratio_translucent_over_path_traced"]["mc"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    for (ch, ratio) in mc_against_its_reference(name, &["--scattering", "single"]).into_iter().enumerate() {
+        println!("{name} channel {ch}: single scattering / path traced = {ratio:.4} (recorded {:.4})", measured[ch]);
+        assert!((ratio / measured[ch] - 1.0).abs() < 0.04, "{name} channel {ch}: {ratio} against {}", measured[ch]);
+    }
+}
+
 /// Case `name` rendered with `--model mc` and `extra` flags, against its path-traced image
 /// (tests/data/mitsuba-images, named after the case): the ratio of means per channel over the
 /// pixels both cover.
