@@ -203,12 +203,7 @@ fn single_scattering_against_the_path_tracer() {
         "skin1/sphere-front-single",
         "potato/sphere-front-single",
     ] {
-        let measured: Vec<f64> = case(name)["ratio_translucent_over_path_traced"]["mc"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|v| v.as_f64().unwrap())
-            .collect();
+        let measured = recorded_mc_ratio(name);
         let sampling = ["--scattering", "single", "--brute-force", "--samples", "100000"];
         for (ch, ratio) in mc_against_its_reference(name, &sampling).into_iter().enumerate() {
             println!(
@@ -237,16 +232,21 @@ fn single_scattering_against_the_path_tracer() {
 #[test]
 fn single_scattering_on_the_bunny_against_the_path_tracer() {
     let name = "skin1/bunny-single";
-    let measured: Vec<f64> = case(name)["ratio_translucent_over_path_traced"]["mc"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|v| v.as_f64().unwrap())
-        .collect();
+    let measured = recorded_mc_ratio(name);
     for (ch, ratio) in mc_against_its_reference(name, &["--scattering", "single"]).into_iter().enumerate() {
         println!("{name} channel {ch}: single scattering / path traced = {ratio:.4} (recorded {:.4})", measured[ch]);
         assert!((ratio / measured[ch] - 1.0).abs() < 0.04, "{name} channel {ch}: {ratio} against {}", measured[ch]);
     }
+}
+
+/// The Monte Carlo table's ratio to the path tracer recorded for case `name`, per channel.
+fn recorded_mc_ratio(name: &str) -> Vec<f64> {
+    case(name)["ratio_translucent_over_path_traced"]["mc"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect()
 }
 
 /// Case `name` rendered with `--model mc` and `extra` flags, against its path-traced image
