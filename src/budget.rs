@@ -22,8 +22,11 @@ pub struct FrameSizes {
 }
 
 /// Bytes of one shadow-map array (of one receiver) beyond which many lights get maps of a lower
-/// resolution: 256 MiB, e.g. 64 layers of 1024² or 256 of 512² (32-bit depth).
-pub const SHADOW_MAP_BUDGET: u64 = 256 << 20;
+/// resolution: 512 MiB, e.g. 64 layers of 1024² or 256 of 512² (a 32-bit depth and a 32-bit
+/// normal per texel).
+pub const SHADOW_MAP_BUDGET: u64 = 512 << 20;
+/// Bytes per shadow-map texel: its depth and the normal there (`shadow::SHADOW_NORMAL_FORMAT`).
+pub const SHADOW_TEXEL_BYTES: u64 = 8;
 /// Light counts up to which `--shadow-resolution` is taken as given (and refused if too large).
 pub const FITTED_ABOVE_LIGHTS: usize = 8;
 
@@ -42,7 +45,7 @@ impl FrameSizes {
         if lights.len() <= FITTED_ABOVE_LIGHTS {
             return res;
         }
-        while res > 128 && res as u64 * res as u64 * 4 * layers > SHADOW_MAP_BUDGET {
+        while res > 128 && res as u64 * res as u64 * SHADOW_TEXEL_BYTES * layers > SHADOW_MAP_BUDGET {
             res = (res / 2).max(128);
         }
         res
@@ -117,6 +120,9 @@ pub fn check_frame(ctx: &Context, s: &FrameSizes) -> Result<()> {
         }
     }
     check_image(ctx, "--shadow-resolution", "shadow-map", shadow::SHADOW_FORMAT, shadow_usage, shadow_size, 4)?;
+    let normal_usage = ImageUsageFlags::COLOR_ATTACHMENT | ImageUsageFlags::SAMPLED;
+    let format = shadow::SHADOW_NORMAL_FORMAT;
+    check_image(ctx, "--shadow-resolution", "shadow-map normal", format, normal_usage, shadow_size, 4)?;
 
     // Device memory: the frame's targets, the shadow maps and the hierarchy (host-visible
     // read-back buffers live in another heap on a discrete GPU and are left out).
@@ -124,7 +130,7 @@ pub fn check_frame(ctx: &Context, s: &FrameSizes) -> Result<()> {
         // Colour 16, depth 4, G-buffer 3 × 16, tile lists about 17 (a 16-byte header and 256
         // entries of 4 bytes per 8×8 tile) bytes per pixel.
         (size, w as u64 * h as u64 * (16 + 4 + 3 * 16 + 17)),
-        ("--shadow-resolution", res as u64 * res as u64 * s.shadow_layers as u64 * 4),
+        ("--shadow-resolution", res as u64 * res as u64 * s.shadow_layers as u64 * SHADOW_TEXEL_BYTES),
         ("--samples", crate::hierarchy::bytes_used(s.point_count, s.per_light_count)),
     ];
     let total: u64 = parts.iter().map(|p| p.1).sum();

@@ -57,6 +57,7 @@ macro_rules! shade_inputs {
             work: &$r.work_counters,
             lights: &o.hierarchy.shadows.lights,
             shadow_map: &o.hierarchy.shadows.shadow_map,
+            shadow_normals: &o.hierarchy.shadows.shadow_normals,
             shadow_sampler: &o.hierarchy.shadows.shadow_sampler,
             depth_sampler: &o.hierarchy.shadows.depth_sampler,
             point_lights: &o.hierarchy.sorted_point_lights,
@@ -465,7 +466,7 @@ impl HierarchyPasses {
         casters: &[(&Buffer, &Buffer, u32)],
         shadows: &Shadows,
     ) -> Result<()> {
-        self.shadow.record(rec, casters, &shadows.shadow_map, &shadows.layer_matrices)
+        self.shadow.record(rec, casters, (&shadows.shadow_map, &shadows.shadow_normals), &shadows.layer_matrices)
     }
 
     /// The same among other objects: `casters` (every object's mesh, this one's included) cast

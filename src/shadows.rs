@@ -15,6 +15,8 @@ pub struct Shadows {
     /// `LightSetHeader`, the lights, then one matrix per shadow-map layer.
     pub lights: Buffer,
     pub shadow_map: Image,
+    /// The mesh's normal at each texel of `shadow_map` (`shadow::SHADOW_NORMAL_FORMAT`).
+    pub shadow_normals: Image,
     pub shadow_sampler: Sampler,
     /// Nearest, no comparison: the depth itself (the Monte Carlo table's single scattering
     /// measures how far light travels inside from it).
@@ -51,6 +53,14 @@ impl Shadows {
                 Extent2D { width: resolution, height: resolution },
                 layers.max(2), // an array view even for one light (sampler2DArrayShadow)
                 ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | ImageUsageFlags::SAMPLED,
+            )?,
+            shadow_normals: Image::new_2d(
+                ctx,
+                "shadow-map normals",
+                shadow::SHADOW_NORMAL_FORMAT,
+                Extent2D { width: resolution, height: resolution },
+                layers.max(2),
+                ImageUsageFlags::COLOR_ATTACHMENT | ImageUsageFlags::SAMPLED,
             )?,
             shadow_sampler: Sampler::new(ctx, true, true)?,
             depth_sampler: Sampler::new(ctx, false, false)?,

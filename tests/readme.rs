@@ -58,7 +58,7 @@ fn shadow_resolution_and_fitted_maps_match() {
     assert!(!parses(&["--shadow-resolution", &(lo - 1).to_string()]));
     assert!(!parses(&["--shadow-resolution", &(hi + 1).to_string()]));
     // "Beyond 8 lights the shadow maps' resolution is halved while one object's maps would pass
-    // 256 MiB (64 lights: 1024², 256: 512²)".
+    // 512 MiB (64 lights: 1024², 256: 512²)".
     states(&r, &format!("Beyond {FITTED_ABOVE_LIGHTS} lights the shadow maps' resolution is halved"));
     states(&r, &format!("would pass {} MiB (64 lights: 1024², 256: 512²)", SHADOW_MAP_BUDGET >> 20));
     let dirs = |n: usize| vec![common::dir_light([0.0, 1.0, 0.0], [1.0; 3]); n];

@@ -46,6 +46,8 @@ pub struct ShadeInputs<'a> {
     pub work: &'a Buffer,
     pub lights: &'a Buffer,
     pub shadow_map: &'a Image,
+    /// The mesh's normal at each shadow-map texel (read with texelFetch: single scattering).
+    pub shadow_normals: &'a Image,
     pub shadow_sampler: &'a Sampler,
     /// The shadow map's depth, unfiltered (single scattering).
     pub depth_sampler: &'a Sampler,
@@ -283,6 +285,7 @@ impl ShadePass {
             Bind::Sampled(inputs.shadow_map, inputs.depth_sampler),
             Bind::StorageImageRead(inputs.albedo),
             Bind::Texels(inputs.far_field),
+            Bind::Sampled(inputs.shadow_normals, inputs.depth_sampler),
         ];
         let mut c = *constants;
         c.point_range = glam::UVec4::new(unit.first_point, unit.point_count, unit.object, inputs.list_tile);

@@ -1,7 +1,9 @@
 //! Shadow maps: the depth of every object seen from each light, one layer of a 2D-array depth
 //! image per directional light, six (+x −x +y −y +z −z) per point light, one perspective layer
 //! per spot light (six, as a point light, when its cone is wider than 60°), fitted to the object
-//! that receives the shadows. Reads: every object's vertices and indices. Writes: the shadow map.
+//! that receives the shadows, with the mesh's interpolated normal at each texel (where single
+//! scattering's light enters, shade.frag). Reads: every object's vertices and indices. Writes:
+//! the shadow map and its normals.
 
 use glam::{Mat4, Vec3};
 
@@ -12,6 +14,9 @@ use crate::vk::{
 };
 
 pub const SHADOW_FORMAT: Format = Format::D32_SFLOAT;
+/// The normal at each shadow-map texel, octahedron-encoded in 2×16-bit snorm (points.glsl's
+/// `encode_oct`); R32_UINT is a colour attachment on every Vulkan device.
+pub const SHADOW_NORMAL_FORMAT: Format = Format::R32_UINT;
 
 /// The light's view-projection matrices (one per layer) for a receiver in the sphere (centre,
 /// radius), with the box of the other objects that may cast shadows on it (`casters`). The maps
@@ -113,11 +118,11 @@ impl ShadowPass {
             ctx,
             &GraphicsDesc {
                 vertex_shader: "hierarchy/shadow.vert",
-                fragment_shader: None,
+                fragment_shader: Some("hierarchy/shadow.frag"),
                 vertex_stride: 24,
-                vertex_attributes: &[(0, Format::R32G32B32_SFLOAT, 0)],
+                vertex_attributes: &[(0, Format::R32G32B32_SFLOAT, 0), (1, Format::R32G32B32_SFLOAT, 12)],
                 topology: PrimitiveTopology::TRIANGLE_LIST,
-                color_formats: &[],
+                color_formats: &[SHADOW_NORMAL_FORMAT],
                 depth_format: Some(SHADOW_FORMAT),
                 depth_test: true,
                 depth_bias: true,
@@ -129,12 +134,13 @@ impl ShadowPass {
         Ok(ShadowPass { pipeline })
     }
 
-    /// Every mesh of `casters` (vertices, indices, index count) into each layer of `shadow_map`.
+    /// Every mesh of `casters` (vertices, indices, index count) into each layer of `shadow_map`
+    /// and of `normals`.
     pub fn record(
         &self,
         rec: &mut Recorder,
         casters: &[(&Buffer, &Buffer, u32)],
-        shadow_map: &Image,
+        (shadow_map, normals): (&Image, &Image),
         matrices: &[Mat4],
     ) -> Result<()> {
         for (layer, matrix) in matrices.iter().enumerate() {
@@ -142,7 +148,7 @@ impl ShadowPass {
                 rec.use_buffer(vertices, vk::Access::VERTEX_INPUT)?;
                 rec.use_buffer(indices, vk::Access::INDEX_INPUT)?;
             }
-            rec.begin_rendering(&[], Some((shadow_map, Some(1.0))), layer as u32)?;
+            rec.begin_rendering(&[(normals, Some([0.0; 4]))], Some((shadow_map, Some(1.0))), layer as u32)?;
             rec.set_depth_bias(0.0, 1.5);
             for &(vertices, indices, count) in casters {
                 let matrix = bytemuck::bytes_of(matrix);
