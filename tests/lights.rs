@@ -136,3 +136,40 @@ fn merged_lights_on_an_irregular_mesh() {
         }
     }
 }
+
+/// A point light's cube faces hold every point of the receiver's sphere inside their depth
+/// range, however far the light is: a face measures depth along its axis, not the distance, so
+/// the distance as its near plane clipped an object off the face's axis out of the map (the
+/// default bunny under `--light point:0,30,40`: no single scattering and no shadow).
+#[test]
+fn cube_faces_hold_the_receiver_in_depth() {
+    use translucent::passes::shadow::light_matrices;
+    let (centre, radius) = (Vec3::new(0.1, 0.2, -0.1), 1.0);
+    for position in [Vec3::new(0.0, 30.0, 40.0), Vec3::new(3.0, 0.0, 0.0), Vec3::new(-5.0, 7.0, 2.0)] {
+        let faces = light_matrices(&Light::Point { position, intensity: Vec3::ONE }, centre, radius, None);
+        assert_eq!(faces.len(), 6);
+        let n = 2000;
+        for i in 0..n {
+            // A Fibonacci lattice over the sphere.
+            let z = 1.0 - 2.0 * (i as f32 + 0.5) / n as f32;
+            let phi = i as f32 * 2.399_963;
+            let p = centre + radius * Vec3::new((1.0 - z * z).sqrt() * phi.cos(), (1.0 - z * z).sqrt() * phi.sin(), z);
+            // The face the shaders pick (lights.glsl `cube_face`: +x −x +y −y +z −z).
+            let (d, a) = (p - position, (p - position).abs());
+            let face = if a.x >= a.y && a.x >= a.z {
+                (d.x < 0.0) as usize
+            } else if a.y >= a.z {
+                2 + (d.y < 0.0) as usize
+            } else {
+                4 + (d.z < 0.0) as usize
+            };
+            let clip = faces[face] * p.extend(1.0);
+            let ndc = clip.truncate() / clip.w;
+            assert!(
+                clip.w > 0.0 && ndc.x.abs() <= 1.0 && ndc.y.abs() <= 1.0,
+                "light at {position}: {p} off face {face}"
+            );
+            assert!((0.0..=1.0).contains(&ndc.z), "light at {position}: {p} at depth {} in face {face}", ndc.z);
+        }
+    }
+}

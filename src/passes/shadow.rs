@@ -91,6 +91,12 @@ fn near_far(position: Vec3, centre: Vec3, radius: f32, casters: Option<(Vec3, Ve
 /// The six 91° cube faces of a light at `position` (+x −x +y −y +z −z).
 fn cube_faces(position: Vec3, centre: Vec3, radius: f32, casters: Option<(Vec3, Vec3)>) -> Vec<Mat4> {
     let (near, far) = near_far(position, centre, radius, casters);
+    // A face measures depth along its axis, not the distance: a point at distance D seen at its
+    // corner (tan 45.5° off the axis both ways) lies at D / √(1 + 2 tan² 45.5°) ≈ D / 1.75 along
+    // it. With the distance as the near plane an object off a face's axis was clipped out of the
+    // map (the default bunny under `--light point:0,30,40`: no single scattering, no shadow).
+    let corner = 1.0 / (1.0 + 2.0 * 45.5f32.to_radians().tan().powi(2)).sqrt();
+    let near = (near * corner).max(far * 1e-4);
     let faces = [
         (Vec3::X, Vec3::Y),
         (Vec3::NEG_X, Vec3::Y),
