@@ -17,7 +17,7 @@ fn shade_frag_declares_its_buffers_texels_and_images() {
     assert_eq!(r.stage, Stage::Fragment);
     let numbers: Vec<u32> = r.bindings.iter().map(|b| b.binding).collect();
     assert_eq!(numbers, (0..numbers.len() as u32).collect::<Vec<_>>(), "bindings 0..n in order");
-    assert_eq!(r.bindings.len(), 19, "{:?}", r.bindings);
+    assert_eq!(r.bindings.len(), 20, "{:?}", r.bindings);
     for b in &r.bindings {
         assert_eq!((b.set, b.count), (0, 1), "{b:?}");
         let expected = match b.binding {
@@ -27,8 +27,9 @@ fn shade_frag_declares_its_buffers_texels_and_images() {
             3 => (DescriptorKind::StorageBuffer, false),
             // The lights and shadow-map matrices.
             4 => (DescriptorKind::StorageBuffer, true),
-            // sampler2DArrayShadow, and the same map's depth (sampler2DArray): combined image samplers.
-            5 | 16 => (DescriptorKind::CombinedImageSampler, true),
+            // sampler2DArrayShadow, the same map's depth (sampler2DArray) and the mesh's normal at
+            // each of its texels (usampler2DArray): combined image samplers.
+            5 | 16 | 19 => (DescriptorKind::CombinedImageSampler, true),
             // The G-buffer's position, normal and texture (the scatter weight), read.
             8 | 9 | 17 => (DescriptorKind::StorageImage, true),
             // Nodes, points, their light records, the tile lists, the dipole table and the far
