@@ -143,3 +143,105 @@ fn gpu_table_models_match_cpu() {
     drop(ctx);
     assert_clean(&counts);
 }
+
+/// The Monte Carlo table's curvature terms as the shade pass reads them (bssrdf.glsl
+/// `curvature_rows` + `curvature_ratio`, `curvature_exit`, `exit_tilt`; f16 texels, f32
+/// arithmetic) against their Rust mirrors (`CurvatureRatios::lookup`, `lookup_exit`,
+/// `exit_tilt_at`; the same f16 values in f64), for Skin1: random chords out to 30 L, curvatures
+/// of both signs from L/64 to 16 L (past the last node too) and flat, exit cosines and far
+/// shares. Within 1e-5 relative (the tilt, which crosses 0, 1e-5 absolute and relative; measured
+/// 8e-7 for the ratio, 2e-7 for the exit's, the tilt exact), except where the nearest entry's
+/// index lies within 1e-4 of a boundary (f32 and f64 may round apart). It found the Rust mirror
+/// of f16 dropping the sign (the tilt's g is negative near the entry).
+#[test]
+fn gpu_curvature_terms_match_cpu() {
+    use translucent::gpu::sd_table::{
+        AngularFactors, CurvatureRatios, SlabTransmission, CURVATURE_TABLE_ENTRIES, EXIT_TILT_ENTRIES, TABLE_SIZE,
+    };
+    use translucent::materials::Material;
+    use translucent::physics::curvature_profile;
+    use translucent::physics::mc_profile::McProfile;
+    use translucent::vk::{self, Bind, Buffer, BufferUsageFlags, MemoryLocation, Pipeline};
+
+    let m = Material::find("skin1").unwrap();
+    let media = [0, 1, 2].map(|c| m.channel(c));
+    let ratios = CurvatureRatios::monte_carlo(&curvature_profile::of_channels(&media), &McProfile::of_channels(&media));
+    let unit = ratios.unit_mm as f64;
+    assert!(unit > 0.0);
+    // The object's table as the shade pass binds it, zeros before the curvature rows.
+    let mut texels = vec![[0u32; 4]; TABLE_SIZE + AngularFactors::TEXELS + SlabTransmission::TEXELS];
+    texels.extend(ratios.texels());
+
+    // A small deterministic generator (xorshift).
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let mut uniform = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let n = 4096;
+    let queries: Vec<[f32; 4]> = (0..n)
+        .map(|i| {
+            let r = 30.0 * unit * uniform().powi(2);
+            let magnitude = 2f64.powf(-6.0 + 10.0 * uniform()) / unit;
+            let kappa = match i % 8 {
+                0 => 0.0,
+                k if k % 2 == 1 => -magnitude,
+                _ => magnitude,
+            };
+            [r as f32, kappa as f32, uniform() as f32, uniform() as f32]
+        })
+        .collect();
+
+    let (ctx, counts) = validated_context();
+    let results: Vec<[f32; 4]> = {
+        let pipeline = Pipeline::compute(&ctx, "test/curvature_terms.comp").unwrap();
+        let table = vk::upload_buffer(&ctx, "table", &texels, BufferUsageFlags::UNIFORM_TEXEL_BUFFER).unwrap();
+        let input = vk::upload_buffer(&ctx, "queries", &queries, BufferUsageFlags::STORAGE_BUFFER).unwrap();
+        let usage = BufferUsageFlags::STORAGE_BUFFER | BufferUsageFlags::TRANSFER_SRC;
+        let output = Buffer::new(&ctx, "results", 64 * n as u64, usage, MemoryLocation::GpuOnly).unwrap();
+        let binds = [Bind::Read(&input), Bind::Write(&output), Bind::Texels(&table)];
+        let count = n as u32;
+        ctx.submit(None, |rec| rec.dispatch(&pipeline, &binds, bytemuck::bytes_of(&count), [count.div_ceil(64), 1, 1]))
+            .unwrap();
+        vk::download_buffer(&ctx, &output, 4 * n).unwrap()
+    };
+    drop(ctx);
+    assert_clean(&counts);
+
+    // How near an entry boundary the nearest-entry read falls (f32 against f64).
+    let near_boundary = |x: f64| x > 0.5 && (x - x.round()).abs() < 1e-4;
+    let (mut checked, mut worst) = (0, [0.0f64; 4]);
+    for (i, q) in queries.iter().enumerate() {
+        let [r, kappa, cos_o, far] = q.map(|v| v as f64);
+        let held = kappa.abs().min(curvature_profile::last_curvature(unit));
+        let s = r * held;
+        let tilt_u = r / (r + unit) * EXIT_TILT_ENTRIES as f64;
+        if near_boundary(s / (s + 1.0) * CURVATURE_TABLE_ENTRIES as f64) || near_boundary(tilt_u) {
+            continue;
+        }
+        let [c, g] = ratios.exit_tilt_at(r);
+        let cpu = [ratios.lookup(r, kappa), ratios.lookup_exit(cos_o, kappa, far), c, g];
+        for (k, expected) in cpu.iter().enumerate() {
+            for ch in 0..3 {
+                let gpu = results[4 * i + k][ch] as f64;
+                let e = expected[ch];
+                // Relative for the ratios, absolute for the tilt.
+                let err = if k >= 2 { (gpu - e).abs() } else { (gpu - e).abs() / e.abs().max(1e-6) };
+                let bound = if k >= 2 { 1e-5 + 1e-5 * e.abs() } else { 1e-5 };
+                assert!(
+                    err <= bound,
+                    "query {i} (r {r}, κ {kappa}, cos_o {cos_o}, far {far}) term {k} channel {ch}: GPU {gpu} against {e}"
+                );
+                worst[k] = worst[k].max(err);
+            }
+        }
+        checked += 1;
+    }
+    println!(
+        "{checked} queries; worst ratio {:.1e}, exit {:.1e}, c {:.1e}, g {:.1e}",
+        worst[0], worst[1], worst[2], worst[3]
+    );
+    assert!(checked > n * 9 / 10, "only {checked} of {n} queries checked");
+}

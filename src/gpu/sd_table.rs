@@ -568,10 +568,14 @@ fn half_bits(x: f32) -> u16 {
 fn half_value(h: u16) -> f64 {
     let exponent = ((h >> 10) & 0x1f) as i32;
     let mantissa = (h & 0x3ff) as f64;
-    if exponent == 0 {
-        mantissa * 2f64.powi(-24)
+    let magnitude =
+        if exponent == 0 { mantissa * 2f64.powi(-24) } else { (1.0 + mantissa / 1024.0) * 2f64.powi(exponent - 15) };
+    // The sign bit (the exit tilt's g is negative near the entry; GLSL's unpackHalf2x16 keeps
+    // it, and this mirror dropped it until the GPU cross-test, tests/bssrdf_gpu.rs).
+    if h & 0x8000 != 0 {
+        -magnitude
     } else {
-        (1.0 + mantissa / 1024.0) * 2f64.powi(exponent - 15)
+        magnitude
     }
 }
 
@@ -585,11 +589,14 @@ mod tests {
     #[test]
     fn half_conversion_rounds_to_nearest() {
         for x in [0.0f32, 1.0, 0.5, 1e-3, 6.1e-5, 3e-6, 5.9604645e-8, 1e-9, 0.33333334, 0.9999] {
-            let h = half_bits(x);
-            let back = half_value(h);
-            let ulp = if back < 6.1e-5 { 2f64.powi(-24) } else { back * 2f64.powi(-10) };
-            assert!((back - x as f64).abs() <= 0.5 * ulp + 1e-30, "{x}: {back}");
+            for x in [x, -x] {
+                let h = half_bits(x);
+                let back = half_value(h);
+                let ulp = if back.abs() < 6.1e-5 { 2f64.powi(-24) } else { back.abs() * 2f64.powi(-10) };
+                assert!((back - x as f64).abs() <= 0.5 * ulp + 1e-30, "{x}: {back}");
+            }
         }
+        assert_eq!(half_value(0xbc00), -1.0);
         assert_eq!(half_bits(1.0), 0x3c00);
         assert_eq!(half_bits(0.5), 0x3800);
     }

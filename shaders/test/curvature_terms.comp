@@ -1,0 +1,30 @@
+#version 460
+// For tests/bssrdf_gpu.rs only: the Monte Carlo table's curvature terms as the shade pass reads
+// them (bssrdf.glsl: `curvature_ratio`, `curvature_exit`, `exit_tilt`), against their Rust
+// mirrors (gpu::sd_table::CurvatureRatios::lookup, lookup_exit, exit_tilt_at).
+#include "gpu_constants.glsl"
+#include "bssrdf.glsl"
+
+layout(local_size_x = 64) in;
+
+// Per query: the chord r (mm), the pair's curvature κ (1/mm), the exit cosine and the far
+// light's share.
+layout(std430, binding = 0) readonly buffer Queries { vec4 queries[]; };
+// Per query four: the ratio, the exit's ratio, the tilt's c and g (rgb).
+layout(std430, binding = 1) writeonly buffer Results { vec4 results[]; };
+// An object's table (its curvature rows from CURVATURE_BASE).
+layout(binding = 2) uniform usamplerBuffer table;
+layout(push_constant) uniform Constants { uint count; } pc;
+
+void main() {
+    uint i = gl_GlobalInvocationID.x;
+    if (i >= pc.count) return;
+    vec4 q = queries[i];
+    vec4 rows = curvature_rows(table, q.y);
+    vec3 c, g;
+    exit_tilt(table, rows.w, q.x, c, g);
+    results[4u * i] = vec4(curvature_ratio(table, rows, q.x), 0.0);
+    results[4u * i + 1u] = vec4(curvature_exit(table, rows, q.z, q.w), 0.0);
+    results[4u * i + 2u] = vec4(c, 0.0);
+    results[4u * i + 3u] = vec4(g, 0.0);
+}
