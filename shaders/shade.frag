@@ -323,26 +323,29 @@ vec3 interval_integral(vec3 sigma, float g0, float g1, float len) {
     return len * mix(series, closed, step(vec3(1e-3), abs(a)));
 }
 
-// The mesh's normal where the light meets it at the texel corner `corner` (in texels): the
-// texel's at +u, +v from it (shadow.frag: interpolated from the vertex normals, the shading
-// normal a path tracer refracts at; the mean of the four around the corner measured the same
-// and cost 1.1x more). The entry took the facets' normal from the depths' differences before:
-// the default Skin1 bunny's single scattering was 0.69 0.73 0.75 of the path tracer's with it,
-// 0.80 0.82 0.82 with this (README, "The default bunny").
-vec3 mesh_normal_at(vec2 corner, uint layer) {
+// The mesh's normal where the light meets it at the texel corner `corner` (in texels), and its
+// mean curvature there (1/scene unit): the texel's at +u, +v from it (shadow.frag: interpolated
+// from the vertex normals, the shading normal a path tracer refracts at; the mean of the four
+// around the corner measured the same and cost 1.1x more). The entry took the facets' normal
+// from the depths' differences before: the default Skin1 bunny's single scattering was 0.69 0.73
+// 0.75 of the path tracer's with it, 0.80 0.82 0.82 with this (README, "The default bunny").
+vec3 mesh_normal_at(vec2 corner, uint layer, out float curvature) {
     ivec2 size = textureSize(shadow_normals, 0).xy;
     ivec2 texel = clamp(ivec2(corner), ivec2(0), size - 1);
-    return decode_oct(texelFetch(shadow_normals, ivec3(texel, int(layer)), 0).r);
+    uvec2 normal_curvature = texelFetch(shadow_normals, ivec3(texel, int(layer)), 0).rg;
+    curvature = uintBitsToFloat(normal_curvature.y);
+    return decode_oct(normal_curvature.x);
 }
 
 // The surface the shadow map sees at `uv` (the corner of texels nearest it, unprojected by
 // `unproject`: the mean of the four texels' points around it, one gather) and the mesh's normal
-// there. False where they do not span a surface (beyond the map, a silhouette seen from the
-// light).
-bool entry_surface(vec2 uv, uint layer, mat4 unproject, out vec3 point, out vec3 normal) {
+// and mean curvature there. False where they do not span a surface (beyond the map, a
+// silhouette seen from the light).
+bool entry_surface(vec2 uv, uint layer, mat4 unproject, out vec3 point, out vec3 normal, out float curvature) {
     vec2 size = vec2(textureSize(shadow_depth, 0).xy);
     point = vec3(0.0);
     normal = vec3(0.0, 0.0, 1.0);
+    curvature = 0.0;
     if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return false;
     // The corner: gather takes the 2×2 texels around it (floor(uv·size − 0.5) is half a texel
     // from any rounding of an integer).
@@ -357,7 +360,7 @@ bool entry_surface(vec2 uv, uint layer, mat4 unproject, out vec3 point, out vec3
     vec4 q2 = unproject * vec4(ndc_hi.x, ndc_lo.y, d.z, 1.0);
     vec4 q3 = unproject * vec4(ndc_lo.x, ndc_lo.y, d.w, 1.0);
     point = 0.25 * (q0.xyz / q0.w + q1.xyz / q1.w + q2.xyz / q2.w + q3.xyz / q3.w);
-    normal = mesh_normal_at(corner, layer);
+    normal = mesh_normal_at(corner, layer, curvature);
     return true;
 }
 
@@ -378,17 +381,18 @@ float shadow_bias_distance(float cos_l, float max_tan) {
 // past a terminator (light grazing the surface beyond it), the straight line toward the light
 // crosses the lit side far away, where light enters at a steep angle that its tangent plane
 // would carry to x but the real, curving surface does not. Returns h (scene units, ≥ 0), the
-// cosine at the entry and how far x lies from the light refracted there (`miss`, scene units:
+// cosine at the entry, how far x lies from the light refracted there (`miss`, scene units:
 // where no refracted light reaches x, in the shadow a curved surface casts inside itself beyond a
-// terminator, the steps find no entry and it stays large); false where the map sees no surface.
+// terminator, the steps find no entry and it stays large) and the mesh's mean curvature at the
+// entry (1/scene unit); false where the map sees no surface.
 const int SS_ENTRY_STEPS = 4;
 bool light_entry(vec3 x, vec2 uv, uint layer, mat4 unproject, vec3 toward, float eta, out float h, out float cos_l,
-                 out float miss) {
+                 out float miss, out float curvature) {
     vec3 y, n;
     h = 0.0;
     cos_l = 0.0;
     miss = 0.0;
-    if (!entry_surface(uv, layer, unproject, y, n)) return false;
+    if (!entry_surface(uv, layer, unproject, y, n, curvature)) return false;
     vec3 entry, t;
     for (int step = 0; step <= SS_ENTRY_STEPS; ++step) {
         cos_l = clamp(dot(n, toward), 0.0, 1.0);
@@ -400,9 +404,11 @@ bool light_entry(vec3 x, vec2 uv, uint layer, mat4 unproject, vec3 toward, float
         vec3 plane_entry = x - t * (h / cos_t);
         vec4 clip = layer_matrix(layer) * vec4(plane_entry, 1.0);
         vec3 y2, n2;
-        if (!entry_surface(clip.xy / clip.w * 0.5 + 0.5, layer, unproject, y2, n2)) break;
+        float curvature2;
+        if (!entry_surface(clip.xy / clip.w * 0.5 + 0.5, layer, unproject, y2, n2, curvature2)) break;
         y = y2;
         n = n2;
+        curvature = curvature2;
     }
     // How far x lies from the light refracted at the last entry.
     vec3 v = x - entry;
@@ -411,7 +417,9 @@ bool light_entry(vec3 x, vec2 uv, uint layer, mat4 unproject, vec3 toward, float
 }
 
 // How a curved entry focuses the refracted beam: a parallel beam through a surface of curvature
-// κ (a ball's 1/R; the pixel's mean curvature stands for the entry's) converges with refracting
+// κ (a ball's 1/R; the mesh's mean curvature at the entry, smoothed over a diffusion length: an
+// ear curves two ways, not as a ball, but its shape operator there measured no better at a
+// scale clean of speckles, README "The default bunny") converges with refracting
 // power P = (η cos θt − cos θi)·κ, toward its sagittal focus η/P and tangential focus
 // η cos²θt/P along the ray (Coddington's equations); at a distance l along it the beam's cross
 // section has shrunk by (1 − l P/η)(1 − l P/(η cos²θt)), and its flux per unit area grown by
@@ -435,7 +443,7 @@ float lens_gain(float l_mm, float cos_i, float cos_t, float eta, float kappa_mm)
 // bright beyond a Ketchup sphere's terminator), no light where refracted light does not reach
 // x, and the beam's focusing by a curved entry (lens_gain). Against the path tracer's light
 // scattered once (tests/ground_truth.rs): 10 mm spheres front-lit 1.01-1.02, back-lit
-// 0.94-0.97, the default Skin1 bunny 0.80-0.82. 1/η²: radiance leaving a denser medium. Between samples s + s_l is taken linear,
+// 0.94-0.97, the default Skin1 bunny 0.84-0.85. 1/η²: radiance leaving a denser medium. Between samples s + s_l is taken linear,
 // so each interval's integral is exact there, and the beam's mean of its ends; samples the shadow map puts outside the object (nearer the light than its surface)
 // scatter nothing, and an interval with one such end counts up to where the depth differences
 // at its ends say the ray crosses the surface.
@@ -506,12 +514,19 @@ vec3 single_scattering(vec3 xo, vec3 no, vec3 wo) {
                     cached_layer = layer;
                 }
                 float h, cos_l, miss;
-                if (!light_entry(x, uv, layer, unproject, toward, eta, h, cos_l, miss)) {
+                // The curvature where the light enters (the pixel's where the map sees no entry):
+                // at the base of the bunny's ear the pixel is concave where the entry, on the
+                // ear's back, is convex; there the pixel's gave single scattering 0.80 0.82 0.82
+                // of the path tracer's, the entry's 0.84 0.85 0.84.
+                float entry_curvature_mm = pixel_curvature_mm;
+                if (!light_entry(x, uv, layer, unproject, toward, eta, h, cos_l, miss, entry_curvature_mm)) {
                     // No surface around it in the map (its edge): the pixel's own, straight.
+                    entry_curvature_mm = pixel_curvature_mm;
                     vec4 p = unproject * vec4(ndc.xy, depth, 1.0);
                     cos_l = abs(dot(no, toward));
                     h = max(dot(p.xyz / p.w - x, toward), 0.0) * cos_l;
                 } else {
+                    entry_curvature_mm /= mm;
                     // The bias at this entry (its slope held at tan θl ≤ 8: the band a few
                     // texels, not the whole way to a grazing surface), for this sample's depth
                     // difference and the next ones'.
@@ -536,7 +551,7 @@ vec3 single_scattering(vec3 xo, vec3 no, vec3 wo) {
                 float reached = 1.0 - smoothstep(tolerance, 2.0 * tolerance, miss);
                 // The beam's flux inside per unit area across it (its irradiance at normal incidence outside).
                 beam = enters ? reached * incident * cos_l * fresnel_transmittance(eta, cos_l) / cos_t : vec3(0.0);
-                if (enters) beam *= lens_gain(h * mm / cos_t, cos_l, cos_t, eta, pixel_curvature_mm);
+                if (enters) beam *= lens_gain(h * mm / cos_t, cos_l, cos_t, eta, entry_curvature_mm);
             }
             float ds = s - s_prev;
             if (k > 0u && inside && inside_prev) {

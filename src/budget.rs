@@ -22,11 +22,12 @@ pub struct FrameSizes {
 }
 
 /// Bytes of one shadow-map array (of one receiver) beyond which many lights get maps of a lower
-/// resolution: 512 MiB, e.g. 64 layers of 1024² or 256 of 512² (a 32-bit depth and a 32-bit
-/// normal per texel).
-pub const SHADOW_MAP_BUDGET: u64 = 512 << 20;
-/// Bytes per shadow-map texel: its depth and the normal there (`shadow::SHADOW_NORMAL_FORMAT`).
-pub const SHADOW_TEXEL_BYTES: u64 = 8;
+/// resolution: 768 MiB, e.g. 64 layers of 1024² or 256 of 512² (a 32-bit depth, a 32-bit normal
+/// and a 32-bit curvature per texel).
+pub const SHADOW_MAP_BUDGET: u64 = 768 << 20;
+/// Bytes per shadow-map texel: its depth, and the normal and curvature there
+/// (`shadow::SHADOW_NORMAL_FORMAT`).
+pub const SHADOW_TEXEL_BYTES: u64 = 12;
 /// Light counts up to which `--shadow-resolution` is taken as given (and refused if too large).
 pub const FITTED_ABOVE_LIGHTS: usize = 8;
 
@@ -120,9 +121,9 @@ pub fn check_frame(ctx: &Context, s: &FrameSizes) -> Result<()> {
         }
     }
     check_image(ctx, "--shadow-resolution", "shadow-map", shadow::SHADOW_FORMAT, shadow_usage, shadow_size, 4)?;
-    let normal_usage = ImageUsageFlags::COLOR_ATTACHMENT | ImageUsageFlags::SAMPLED;
+    let normal_usage = ImageUsageFlags::COLOR_ATTACHMENT | ImageUsageFlags::SAMPLED | ImageUsageFlags::TRANSFER_SRC;
     let format = shadow::SHADOW_NORMAL_FORMAT;
-    check_image(ctx, "--shadow-resolution", "shadow-map normal", format, normal_usage, shadow_size, 4)?;
+    check_image(ctx, "--shadow-resolution", "shadow-map normal", format, normal_usage, shadow_size, 8)?;
 
     // Device memory: the frame's targets, the shadow maps and the hierarchy (host-visible
     // read-back buffers live in another heap on a discrete GPU and are left out).

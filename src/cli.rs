@@ -423,7 +423,7 @@ pub struct RenderArgs {
     pub samples: Option<u32>,
     /// Shadow-map resolution per light (per cube face for point lights and spots wider than 60°).
     /// With more than 8 lights (an environment's samples) it is halved while one object's maps
-    /// would take more than 512 MiB (depth and normals), down to 128.
+    /// would take more than 768 MiB (depth, normals and curvature), down to 128.
     #[arg(long, allow_hyphen_values = true, default_value_t = crate::frame_desc::DEFAULT_SHADOW_RESOLUTION, value_parser = clap::value_parser!(u32).range(16..=8192))]
     pub shadow_resolution: u32,
     /// Draw a debug view over the mesh: the sample points or the tree's boxes at --level.

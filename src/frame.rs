@@ -21,7 +21,7 @@ use crate::passes::far_field::{FarFieldInputs, FarFieldPass};
 use crate::passes::irradiance::IrradiancePass;
 use crate::passes::sampling::SamplingPass;
 use crate::passes::shade::{self, ShadeInputs, ShadePass, SurfaceDraw};
-use crate::passes::shadow::ShadowPass;
+use crate::passes::shadow::{Caster, ShadowPass};
 use crate::passes::sort::SortPass;
 use crate::passes::tile_cut::{initial_entries_per_tile, list_tile, TileCutPass, TileLists, FAR_FIELD_TILE};
 use crate::passes::tonemap::{self, TonemapPass};
@@ -428,6 +428,8 @@ pub struct HierarchyPasses {
     no_factors: Buffer,
     /// No texture (a scatter weight of 1 everywhere), for the same.
     no_texture: SurfaceTexture,
+    /// No curvature (one 0, which the shadow pass reads for every vertex), for the same.
+    no_curvature: Buffer,
 }
 
 impl HierarchyPasses {
@@ -443,6 +445,7 @@ impl HierarchyPasses {
         no_factors.write((table_texels * 16) as u64, &AngularFactors::none().texels())?;
         Ok(HierarchyPasses {
             no_factors,
+            no_curvature: vk::upload_buffer(ctx, "no curvature", &[0.0f32], BufferUsageFlags::STORAGE_BUFFER)?,
             no_texture: SurfaceTexture::new(ctx, &crate::world::Reflectance::Constant(glam::Vec3::ONE), None, 1)?,
             sampling: SamplingPass::new(ctx)?,
             shadow: ShadowPass::new(ctx)?,
@@ -455,17 +458,12 @@ impl HierarchyPasses {
     /// The frame's first seven passes: `h` rebuilt from the mesh in `vertices` and `indices`,
     /// alone in the world. Tests and tools record them so to build a hierarchy.
     pub fn record(&self, rec: &mut Recorder, h: &Hierarchy, vertices: &Buffer, indices: &Buffer) -> Result<()> {
-        let casters = [(vertices, indices, h.index_count)];
+        let casters = [(vertices, indices, h.index_count, &self.no_curvature)];
         self.record_among(rec, h, (vertices, indices), &self.no_texture, &self.no_factors, &casters)
     }
 
     /// Every mesh of `casters` into the maps of `shadows`.
-    pub fn record_shadows(
-        &self,
-        rec: &mut Recorder,
-        casters: &[(&Buffer, &Buffer, u32)],
-        shadows: &Shadows,
-    ) -> Result<()> {
+    pub fn record_shadows(&self, rec: &mut Recorder, casters: &[Caster], shadows: &Shadows) -> Result<()> {
         self.shadow.record(rec, casters, (&shadows.shadow_map, &shadows.shadow_normals), &shadows.layer_matrices)
     }
 
@@ -479,7 +477,7 @@ impl HierarchyPasses {
         (vertices, indices): (&Buffer, &Buffer),
         texture: &SurfaceTexture,
         sd_table: &Buffer,
-        casters: &[(&Buffer, &Buffer, u32)],
+        casters: &[Caster],
     ) -> Result<()> {
         let n = h.point_count;
         let (sort, tree) = (h.sort_buffers(), h.tree_buffers());
@@ -582,9 +580,13 @@ impl Renderer {
         let far_field = integration.uses_far_field();
         let objects = self.world.objects.len();
         let w = &self.world;
-        let opaque_meshes = w.opaque.iter().map(|o| (&o.vertices, &o.indices, o.index_count));
-        let casters: Vec<_> =
-            w.objects.iter().map(|o| (&o.vertices, &o.indices, o.index_count)).chain(opaque_meshes).collect();
+        let opaque_meshes = w.opaque.iter().map(|o| (&o.vertices, &o.indices, o.index_count, &o.curvature));
+        let casters: Vec<_> = w
+            .objects
+            .iter()
+            .map(|o| (&o.vertices, &o.indices, o.index_count, &o.curvature))
+            .chain(opaque_meshes)
+            .collect();
         let inputs: Vec<ShadeInputs> = (0..objects).map(|k| shade_inputs!(self, k)).collect();
         // Every object's draw into the G-buffer: the translucent ones (ids from 0), then the
         // opaque ones.

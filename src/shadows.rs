@@ -15,7 +15,8 @@ pub struct Shadows {
     /// `LightSetHeader`, the lights, then one matrix per shadow-map layer.
     pub lights: Buffer,
     pub shadow_map: Image,
-    /// The mesh's normal at each texel of `shadow_map` (`shadow::SHADOW_NORMAL_FORMAT`).
+    /// The mesh's normal and mean curvature at each texel of `shadow_map`
+    /// (`shadow::SHADOW_NORMAL_FORMAT`).
     pub shadow_normals: Image,
     pub shadow_sampler: Sampler,
     /// Nearest, no comparison: the depth itself (the Monte Carlo table's single scattering
@@ -60,7 +61,8 @@ impl Shadows {
                 shadow::SHADOW_NORMAL_FORMAT,
                 Extent2D { width: resolution, height: resolution },
                 layers.max(2),
-                ImageUsageFlags::COLOR_ATTACHMENT | ImageUsageFlags::SAMPLED,
+                // Transfer: tests read it back.
+                ImageUsageFlags::COLOR_ATTACHMENT | ImageUsageFlags::SAMPLED | ImageUsageFlags::TRANSFER_SRC,
             )?,
             shadow_sampler: Sampler::new(ctx, true, true)?,
             depth_sampler: Sampler::new(ctx, false, false)?,
@@ -70,6 +72,11 @@ impl Shadows {
             resolution,
             light_count: lights.len() as u32,
         })
+    }
+
+    /// Each layer's view-projection matrix (set by `set_lights`).
+    pub fn layer_matrices(&self) -> &[Mat4] {
+        &self.layer_matrices
     }
 
     /// Writes the lights and their shadow matrices for a receiver in the sphere (centre, radius).
@@ -91,9 +98,12 @@ impl Shadows {
         self.layer_matrices.clear();
         for light in lights {
             light.validate()?;
+            // One layer, or six cube faces (a point light near the receiver, a wide spot): as
+            // `light_matrices` fits them, within the layers allocated for the light.
+            let matrices = shadow::light_matrices(light, centre, radius, self.casters);
             let mut gpu = GpuLight {
                 first_layer: self.layer_matrices.len() as u32,
-                cube: (light.shadow_layers() == 6) as u32,
+                cube: (matrices.len() == 6) as u32,
                 ..GpuLight::default()
             };
             match *light {
@@ -110,7 +120,7 @@ impl Shadows {
                 }
             }
             gpu_lights.push(gpu);
-            self.layer_matrices.extend(shadow::light_matrices(light, centre, radius, self.casters));
+            self.layer_matrices.extend(matrices);
         }
         if self.layer_matrices.len() as u32 > self.shadow_map.layers {
             return Err(runtime!(

@@ -452,3 +452,85 @@ fn a_spot_lights_only_the_points_inside_its_cone() {
     }
     assert!(inside > 200 && outside > 10_000, "{inside} points lit inside the cone, {outside} outside");
 }
+
+/// The shadow pass writes, at each texel the mesh covers, the mesh's interpolated normal and its
+/// mean curvature there (shade.frag refracts single scattering's light and focuses its beam by
+/// them): on a ball of radius 2 lit from an oblique direction, every covered texel holds
+/// curvature 1/2 (the vertices' exactly, interpolated) and the ball's normal where the light's
+/// ray through the texel meets it, within 1°; no texel off the ball is written.
+#[test]
+fn shadow_pass_writes_the_mesh_normal_and_curvature_at_each_texel() {
+    use translucent::hierarchy::decode_oct;
+    use translucent::passes::shadow::Caster;
+    use translucent::shadows::Shadows;
+    use translucent::vk::{upload_buffer, Buffer, MemoryLocation};
+    let radius = 2.0f32;
+    let mesh = Mesh::sphere(radius, 64);
+    let curvature = translucent::mesh::curvature::mean_curvature(&mesh);
+    let toward = Vec3::new(0.3, 0.8, 0.5).normalize();
+    let light = [sun(toward, 1.0)];
+    let resolution = 128u32;
+    let (ctx, counts) = validated_context();
+    let (texels, matrix) = {
+        let storage = BufferUsageFlags::STORAGE_BUFFER;
+        let vertices =
+            upload_buffer(&ctx, "vertices", &mesh.vertex_data(), BufferUsageFlags::VERTEX_BUFFER | storage).unwrap();
+        let indices = upload_buffer(&ctx, "indices", &mesh.indices, BufferUsageFlags::INDEX_BUFFER | storage).unwrap();
+        let curvature = upload_buffer(&ctx, "curvature", &curvature, storage).unwrap();
+        let mut shadows = Shadows::new(&ctx, &light, resolution, ETA).unwrap();
+        shadows.set_lights(Vec3::ZERO, radius, &light).unwrap();
+        let count = (resolution * resolution) as usize;
+        let readback = Buffer::new(
+            &ctx,
+            "normals read back",
+            8 * count as u64,
+            BufferUsageFlags::TRANSFER_DST | BufferUsageFlags::TRANSFER_SRC,
+            MemoryLocation::GpuOnly,
+        )
+        .unwrap();
+        let passes = HierarchyPasses::new(&ctx).unwrap();
+        let casters: [Caster; 1] = [(&vertices, &indices, mesh.indices.len() as u32, &curvature)];
+        ctx.submit(None, |rec| {
+            passes.record_shadows(rec, &casters, &shadows)?;
+            rec.copy_image_to_buffer(&shadows.shadow_normals, &readback)
+        })
+        .unwrap();
+        let texels: Vec<[u32; 2]> = translucent::vk::download_buffer(&ctx, &readback, count).unwrap();
+        (texels, shadows.layer_matrices()[0])
+    };
+    drop(ctx);
+    assert_clean(&counts);
+    let unproject = matrix.inverse();
+    let (mut covered, mut worst_angle, mut worst_curvature) = (0, 0.0f32, 0.0f32);
+    for (i, &[normal, curvature]) in texels.iter().enumerate() {
+        let (x, y) = (i as u32 % resolution, i as u32 / resolution);
+        let ndc = |z: f32| {
+            let v = [x, y].map(|c| (c as f32 + 0.5) / resolution as f32 * 2.0 - 1.0);
+            unproject.project_point3(Vec3::new(v[0], v[1], z))
+        };
+        // The light's ray through the texel's centre, from the near plane: where it meets the ball.
+        let (p0, p1) = (ndc(0.0), ndc(1.0));
+        let d = (p1 - p0).normalize();
+        let b = p0.dot(d);
+        let disc = b * b - (p0.length_squared() - radius * radius);
+        if normal == 0 && curvature == 0 {
+            // Unwritten: only off the ball (or within a texel of its rim, the mesh's polygon).
+            assert!(disc < 0.05 * radius * radius, "texel {x},{y} meets the ball but holds nothing");
+            continue;
+        }
+        assert!(disc > -0.05 * radius * radius, "texel {x},{y} off the ball holds {normal:#x}, {curvature}");
+        let k = f32::from_bits(curvature);
+        worst_curvature = worst_curvature.max((k * radius - 1.0).abs());
+        // Away from the rim, where the polygon and the ball part.
+        if disc > 0.1 * radius * radius {
+            let hit = p0 + d * (-b - disc.sqrt());
+            let angle = decode_oct(normal).dot(hit / radius).clamp(-1.0, 1.0).acos().to_degrees();
+            worst_angle = worst_angle.max(angle);
+            covered += 1;
+        }
+    }
+    println!("{covered} texels: normal within {worst_angle:.3}°, curvature × R within {worst_curvature:.2e} of 1");
+    assert!(covered > 5000, "{covered} texels covered");
+    assert!(worst_angle < 1.0, "normal {worst_angle}° from the ball's");
+    assert!(worst_curvature < 1e-3, "curvature {worst_curvature} off 1/R");
+}

@@ -137,39 +137,72 @@ fn merged_lights_on_an_irregular_mesh() {
     }
 }
 
-/// A point light's cube faces hold every point of the receiver's sphere inside their depth
-/// range, however far the light is: a face measures depth along its axis, not the distance, so
-/// the distance as its near plane clipped an object off the face's axis out of the map (the
-/// default bunny under `--light point:0,30,40`: no single scattering and no shadow).
+/// A point or spot light's shadow maps hold every point of the receiver's sphere that it lights
+/// inside the layer the shaders pick, within its depth range, however far the light is: one
+/// perspective map fitted to the sphere from a light outside it whose cone around the sphere is
+/// at most 60° wide (it reaches the map's edges: the sphere fills it), six cube faces from one
+/// inside or near it. A face measures depth along its axis, not the distance, so the distance as
+/// its near plane clipped an object off the face's axis out of the map; and a far point light had
+/// cube faces, where the default bunny under `--light point:0,30,40` covered 20 × 35 texels.
 #[test]
-fn cube_faces_hold_the_receiver_in_depth() {
+fn light_maps_hold_the_receiver() {
     use translucent::passes::shadow::light_matrices;
     let (centre, radius) = (Vec3::new(0.1, 0.2, -0.1), 1.0);
-    for position in [Vec3::new(0.0, 30.0, 40.0), Vec3::new(3.0, 0.0, 0.0), Vec3::new(-5.0, 7.0, 2.0)] {
-        let faces = light_matrices(&Light::Point { position, intensity: Vec3::ONE }, centre, radius, None);
-        assert_eq!(faces.len(), 6);
+    let point = |position: Vec3| Light::Point { position, intensity: Vec3::ONE };
+    let spot = |position: Vec3, cone_deg: f32| Light::Spot {
+        position,
+        axis: (centre - position).normalize(),
+        intensity: Vec3::ONE,
+        cone_deg,
+        delta_deg: 0.0,
+    };
+    let cases = [
+        (point(Vec3::new(0.0, 30.0, 40.0)), 1),
+        (point(Vec3::new(3.0, 0.0, 0.0)), 1),
+        (point(Vec3::new(-5.0, 7.0, 2.0)), 1),
+        // Just outside: a cone of asin(1.01 / 1.1) = 67° around the sphere.
+        (point(centre + Vec3::new(1.1, 0.0, 0.0)), 6),
+        (point(centre + Vec3::new(0.3, -0.2, 0.1)), 6),
+        (spot(Vec3::new(0.0, 30.0, 40.0), 80.0), 1),
+        (spot(centre + Vec3::new(0.0, 0.0, 1.1), 80.0), 6),
+        // Narrower than the sphere: its own cone.
+        (spot(Vec3::new(3.0, 0.0, 0.0), 10.0), 1),
+    ];
+    for (light, layers) in cases {
+        let maps = light_matrices(&light, centre, radius, None);
+        assert_eq!(maps.len(), layers, "{light:?}");
+        let position = light.position().unwrap();
         let n = 2000;
+        let mut widest = 0.0f32;
         for i in 0..n {
             // A Fibonacci lattice over the sphere.
             let z = 1.0 - 2.0 * (i as f32 + 0.5) / n as f32;
             let phi = i as f32 * 2.399_963;
             let p = centre + radius * Vec3::new((1.0 - z * z).sqrt() * phi.cos(), (1.0 - z * z).sqrt() * phi.sin(), z);
-            // The face the shaders pick (lights.glsl `cube_face`: +x −x +y −y +z −z).
+            if let Light::Spot { axis, cone_deg, .. } = light {
+                if (p - position).normalize().dot(axis) < cone_deg.to_radians().cos() {
+                    continue; // not lit
+                }
+            }
+            // The layer the shaders pick (lights.glsl `cube_face`: +x −x +y −y +z −z).
             let (d, a) = (p - position, (p - position).abs());
-            let face = if a.x >= a.y && a.x >= a.z {
+            let face = if layers == 1 {
+                0
+            } else if a.x >= a.y && a.x >= a.z {
                 (d.x < 0.0) as usize
             } else if a.y >= a.z {
                 2 + (d.y < 0.0) as usize
             } else {
                 4 + (d.z < 0.0) as usize
             };
-            let clip = faces[face] * p.extend(1.0);
+            let clip = maps[face] * p.extend(1.0);
             let ndc = clip.truncate() / clip.w;
-            assert!(
-                clip.w > 0.0 && ndc.x.abs() <= 1.0 && ndc.y.abs() <= 1.0,
-                "light at {position}: {p} off face {face}"
-            );
-            assert!((0.0..=1.0).contains(&ndc.z), "light at {position}: {p} at depth {} in face {face}", ndc.z);
+            assert!(clip.w > 0.0 && ndc.x.abs() <= 1.0 && ndc.y.abs() <= 1.0, "{light:?}: {p} off layer {face}");
+            assert!((0.0..=1.0).contains(&ndc.z), "{light:?}: {p} at depth {} in layer {face}", ndc.z);
+            widest = widest.max(ndc.x.abs().max(ndc.y.abs()));
+        }
+        if layers == 1 {
+            assert!(widest > 0.9, "{light:?}: the receiver spans {widest} of its map");
         }
     }
 }

@@ -58,7 +58,7 @@ fn shadow_resolution_and_fitted_maps_match() {
     assert!(!parses(&["--shadow-resolution", &(lo - 1).to_string()]));
     assert!(!parses(&["--shadow-resolution", &(hi + 1).to_string()]));
     // "Beyond 8 lights the shadow maps' resolution is halved while one object's maps would pass
-    // 512 MiB (64 lights: 1024², 256: 512²)".
+    // 768 MiB (64 lights: 1024², 256: 512²)".
     states(&r, &format!("Beyond {FITTED_ABOVE_LIGHTS} lights the shadow maps' resolution is halved"));
     states(&r, &format!("would pass {} MiB (64 lights: 1024², 256: 512²)", SHADOW_MAP_BUDGET >> 20));
     let dirs = |n: usize| vec![common::dir_light([0.0, 1.0, 0.0], [1.0; 3]); n];
@@ -86,7 +86,7 @@ fn shadow_layers_and_sample_counts_match_the_device() {
     };
     assert_eq!(point.shadow_layers(), 6);
     assert_eq!((spot(SPOT_CUBE_ABOVE_DEG).shadow_layers(), spot(SPOT_CUBE_ABOVE_DEG + 1.0).shadow_layers()), (1, 6));
-    states(&r, &format!("when ANGLE > {SPOT_CUBE_ABOVE_DEG}°"));
+    states(&r, &format!("six cube faces when both are wider than {SPOT_CUBE_ABOVE_DEG}°"));
     let (ctx, counts) = common::validated_context();
     if ctx.info.name.contains("llvmpipe") {
         let usage = ash::vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | ash::vk::ImageUsageFlags::SAMPLED;

@@ -8,7 +8,8 @@ struct GpuLight {
                      // spot: along its axis)
     vec4 axis;       // spot lights: xyz the cone's axis from the light (unit), w cos(cone angle)
     uint first_layer; // its first shadow-map layer
-    uint cube;       // 1: six layers, the cube faces +x -x +y -y +z -z (point lights, wide spots)
+    uint cube;       // 1: six layers, the cube faces +x -x +y -y +z -z (a point light or spot near
+                     // the receiver, a wide spot); 0: one (shadow::light_matrices)
     float cos_falloff_start; // spot lights: cos(cone angle - delta), where the falloff begins
     uint spot;       // 1: a spot light (its falloff applies)
 };

@@ -12,7 +12,8 @@ pub struct GpuLight {
     /// Spot lights: the cone's axis from the light (xyz), cos of the cone angle (w).
     pub axis: Vec4,
     pub first_layer: u32,
-    /// 1: six cube-face layers (point lights, spots wider than 60°); 0: one layer.
+    /// 1: six cube-face layers (a point light or spot near or inside the receiver, a spot wider
+    /// than 60°: `shadow::light_matrices`); 0: one layer.
     pub cube: u32,
     /// Spot lights: cos(cone angle − delta), where the falloff begins.
     pub cos_falloff_start: f32,

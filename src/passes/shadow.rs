@@ -1,25 +1,31 @@
 //! Shadow maps: the depth of every object seen from each light, one layer of a 2D-array depth
 //! image per directional light, six (+x −x +y −y +z −z) per point light, one perspective layer
 //! per spot light (six, as a point light, when its cone is wider than 60°), fitted to the object
-//! that receives the shadows, with the mesh's interpolated normal at each texel (where single
-//! scattering's light enters, shade.frag). Reads: every object's vertices and indices. Writes:
-//! the shadow map and its normals.
+//! that receives the shadows, with the mesh's interpolated normal and mean curvature at each texel
+//! (where single scattering's light enters and how its beam focuses, shade.frag). Reads: every
+//! object's vertices, indices and curvature. Writes: the shadow map and its normals.
 
 use glam::{Mat4, Vec3};
 
 use crate::error::Result;
-use crate::scene::Light;
+use crate::scene::{Light, SPOT_CUBE_ABOVE_DEG};
 use crate::vk::{
-    self, Buffer, Context, CullModeFlags, Format, GraphicsDesc, Image, Pipeline, PrimitiveTopology, Recorder,
+    self, Bind, Buffer, Context, CullModeFlags, Format, GraphicsDesc, Image, Pipeline, PrimitiveTopology, Recorder,
 };
 
 pub const SHADOW_FORMAT: Format = Format::D32_SFLOAT;
 /// The normal at each shadow-map texel, octahedron-encoded in 2×16-bit snorm (points.glsl's
-/// `encode_oct`); R32_UINT is a colour attachment on every Vulkan device.
-pub const SHADOW_NORMAL_FORMAT: Format = Format::R32_UINT;
+/// `encode_oct`), and the mesh's mean curvature there (f32 bits); R32G32_UINT is a colour
+/// attachment on every Vulkan device.
+pub const SHADOW_NORMAL_FORMAT: Format = Format::R32G32_UINT;
 
-/// The light's view-projection matrices (one per layer) for a receiver in the sphere (centre,
-/// radius), with the box of the other objects that may cast shadows on it (`casters`). The maps
+/// A mesh that casts shadows: its vertices, indices, index count and per-vertex mean curvature
+/// (`gpu_world::curvature_buffer`; one 0 for a mesh without).
+pub type Caster<'a> = (&'a Buffer, &'a Buffer, u32, &'a Buffer);
+
+/// The light's view-projection matrices (one per layer: one, or six cube faces +x −x +y −y +z −z
+/// where the light's GpuLight is `cube`; never more layers than `Light::shadow_layers`) for a
+/// receiver in the sphere (centre, radius), with the box of the other objects that may cast shadows on it (`casters`). The maps
 /// cover the receiver's sphere; their depth range reaches toward the light as far as casters lie
 /// in front of the receiver, and no farther, so that a receiver alone, or beside objects that are
 /// not between it and the light, gets the same maps as before.
@@ -49,28 +55,37 @@ pub fn light_matrices(light: &Light, centre: Vec3, radius: f32, casters: Option<
             let (near, far) = (0.5 * radius, 3.5 * radius + extra);
             vec![Mat4::orthographic_rh(-radius, radius, -radius, radius, near, far) * view]
         }
-        Light::Point { position, .. } => cube_faces(position, centre, radius, casters),
-        Light::Spot { .. } if light.shadow_layers() == 6 => {
-            cube_faces(light.position().unwrap(), centre, radius, casters)
-        }
-        Light::Spot { position, axis, cone_deg, .. } => {
-            let (near, far) = near_far(position, centre, radius, casters);
-            // The narrower of two cones that hold every point of the receiver the spot lights (and
-            // so every caster between them): the spot's own, and, from outside the receiver's
-            // sphere, the one around the direction to its centre that holds the sphere.
+        Light::Point { position, .. } | Light::Spot { position, .. } => {
+            // One perspective map over the narrower of two cones that hold every point of the
+            // receiver the light reaches (and so every caster between them): from outside the
+            // receiver's sphere, the one around the direction to its centre that holds the
+            // sphere; a spot's own. Six cube faces where both are wider than 60°: a point light
+            // inside or near the receiver, a wide spot. (A far point light had cube faces too: at
+            // 50 units the default bunny covered 20 × 35 texels of one, and its single scattering
+            // was a ninth of a spot's at the same place.)
+            let widest = SPOT_CUBE_ABOVE_DEG.to_radians();
+            let cone = match *light {
+                Light::Spot { axis, cone_deg, .. } => Some((axis, cone_deg.to_radians())),
+                _ => None,
+            };
             let to_centre = centre - position;
             let distance = to_centre.length();
-            let cone = cone_deg.to_radians();
-            let (dir, half) = match (radius / distance).asin() {
-                holds if distance > radius && holds < cone => (to_centre / distance, holds),
-                _ => (axis, cone),
+            let holds = (radius / distance).asin(); // NaN inside the sphere
+                                                    // A little wider, as the cube faces are, so the cone's edge stays inside the map: 1%
+                                                    // around the sphere (whose radius has its own 1%), 1% and half a degree around a
+                                                    // spot's cone. (Half a degree around the sphere too wasted half of a far light's map:
+                                                    // the bunny 50 units away is 2.5° across.)
+            let (dir, half) = if distance > radius && holds <= widest && cone.is_none_or(|(_, c)| holds < c) {
+                (to_centre / distance, holds * 1.01)
+            } else {
+                match cone {
+                    Some((axis, c)) if c <= widest => (axis, c * 1.01 + 0.5f32.to_radians()),
+                    _ => return cube_faces(position, centre, radius, casters),
+                }
             };
+            let (near, far) = near_far(position, centre, radius, casters);
             let up = if dir.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
-            // A little wider, as the cube faces are, so the cone's edge stays inside the map.
-            vec![
-                Mat4::perspective_rh(2.0 * half * 1.01 + 1f32.to_radians(), 1.0, near, far)
-                    * Mat4::look_at_rh(position, position + dir, up),
-            ]
+            vec![Mat4::perspective_rh(2.0 * half, 1.0, near, far) * Mat4::look_at_rh(position, position + dir, up)]
         }
     }
 }
@@ -140,25 +155,25 @@ impl ShadowPass {
         Ok(ShadowPass { pipeline })
     }
 
-    /// Every mesh of `casters` (vertices, indices, index count) into each layer of `shadow_map`
-    /// and of `normals`.
+    /// Every mesh of `casters` into each layer of `shadow_map` and of `normals`.
     pub fn record(
         &self,
         rec: &mut Recorder,
-        casters: &[(&Buffer, &Buffer, u32)],
+        casters: &[Caster],
         (shadow_map, normals): (&Image, &Image),
         matrices: &[Mat4],
     ) -> Result<()> {
         for (layer, matrix) in matrices.iter().enumerate() {
-            for &(vertices, indices, _) in casters {
+            for &(vertices, indices, _, curvature) in casters {
                 rec.use_buffer(vertices, vk::Access::VERTEX_INPUT)?;
                 rec.use_buffer(indices, vk::Access::INDEX_INPUT)?;
+                rec.prepare_draw_reads(&[Bind::Read(curvature)])?;
             }
             rec.begin_rendering(&[(normals, Some([0.0; 4]))], Some((shadow_map, Some(1.0))), layer as u32)?;
             rec.set_depth_bias(0.0, 1.5);
-            for &(vertices, indices, count) in casters {
+            for &(vertices, indices, count, curvature) in casters {
                 let matrix = bytemuck::bytes_of(matrix);
-                rec.draw(&self.pipeline, &[], matrix, Some(vertices), Some(indices), count, 1)?;
+                rec.draw(&self.pipeline, &[Bind::Read(curvature)], matrix, Some(vertices), Some(indices), count, 1)?;
             }
             rec.end_rendering();
         }
