@@ -538,18 +538,24 @@ impl McProfile {
         self.exitance(r) / self.exit_norm
     }
 
-    /// The azimuthal harmonic b at distance `r` (mm): linear in log ρ between bin centres, held
-    /// beyond the outer ones.
-    pub fn azimuth_factor(&self, r: f64) -> f64 {
+    /// Where distance `r` (mm) falls among the azimuth bins: the two bins to mix and the weight
+    /// of the second, linear in log ρ between bin centres, held beyond the outer ones (the
+    /// first bin below AZIMUTH_MIN, the second up to its centre).
+    fn azimuth_bins_at(&self, r: f64) -> (usize, usize, f64) {
         let rho = r * self.sigma_t_reduced;
-        let x = if rho <= azimuth_bin_centre(1) {
-            return self.azimuth[if rho < AZIMUTH_MIN { 0 } else { 1 }];
-        } else {
-            (rho / AZIMUTH_MIN).log2() * AZIMUTH_PER_OCTAVE + 0.5
-        };
+        if rho <= azimuth_bin_centre(1) {
+            let held = if rho < AZIMUTH_MIN { 0 } else { 1 };
+            return (held, held, 0.0);
+        }
+        let x = (rho / AZIMUTH_MIN).log2() * AZIMUTH_PER_OCTAVE + 0.5;
         let i = (x.floor() as usize).min(AZIMUTH_BINS - 2);
-        let f = (x - i as f64).clamp(0.0, 1.0);
-        self.azimuth[i] + (self.azimuth[i + 1] - self.azimuth[i]) * f
+        (i, i + 1, (x - i as f64).clamp(0.0, 1.0))
+    }
+
+    /// The azimuthal harmonic b at distance `r` (mm), read as `azimuth_bins_at` says.
+    pub fn azimuth_factor(&self, r: f64) -> f64 {
+        let (i, j, f) = self.azimuth_bins_at(r);
+        self.azimuth[i] + (self.azimuth[j] - self.azimuth[i]) * f
     }
 
     /// The exit's tilt [c, g] at distance `r` (mm), read as [`McProfile::azimuth_factor`]
@@ -558,15 +564,8 @@ impl McProfile {
         if self.exit_tilt.len() < AZIMUTH_BINS {
             return [0.0; 2];
         }
-        let rho = r * self.sigma_t_reduced;
-        let x = if rho <= azimuth_bin_centre(1) {
-            return self.exit_tilt[if rho < AZIMUTH_MIN { 0 } else { 1 }];
-        } else {
-            (rho / AZIMUTH_MIN).log2() * AZIMUTH_PER_OCTAVE + 0.5
-        };
-        let i = (x.floor() as usize).min(AZIMUTH_BINS - 2);
-        let f = (x - i as f64).clamp(0.0, 1.0);
-        let (a, b) = (self.exit_tilt[i], self.exit_tilt[i + 1]);
+        let (i, j, f) = self.azimuth_bins_at(r);
+        let (a, b) = (self.exit_tilt[i], self.exit_tilt[j]);
         [a[0] + (b[0] - a[0]) * f, a[1] + (b[1] - a[1]) * f]
     }
 
