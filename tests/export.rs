@@ -148,11 +148,19 @@ fn point_lights_and_the_default_camera_are_in_millimetres() {
             "marble",
         ],
     );
-    // E = I / d² with d in scene units: in mm the intensity is I × 4².
-    assert_eq!(numbers(&attr(&xml, "<emitter type=\"point\"", "<point", "x")), vec![4.0]);
-    assert_eq!(numbers(&attr(&xml, "<emitter type=\"point\"", "<point", "y")), vec![8.0]);
-    assert_eq!(numbers(&attr(&xml, "<emitter type=\"point\"", "<point", "z")), vec![12.0]);
-    assert_eq!(numbers(&attr(&xml, "<emitter type=\"point\"", "name=\"intensity\"", "value")), vec![80.0; 3]);
+    // E = I / d² with d in scene units: in mm the intensity is I × 4². A delta point light behind
+    // the smooth boundary renders black in Mitsuba, so it is a sphere of radius ρ (seen from the
+    // box's centre, the origin, at 5°) emitting I/(πρ²): intensity I toward every direction.
+    let sphere = "<shape type=\"sphere\" id=\"light0\"";
+    assert_eq!(numbers(&attr(&xml, sphere, "<point", "x")), vec![4.0]);
+    assert_eq!(numbers(&attr(&xml, sphere, "<point", "y")), vec![8.0]);
+    assert_eq!(numbers(&attr(&xml, sphere, "<point", "z")), vec![12.0]);
+    let rho = numbers(&attr(&xml, sphere, "name=\"radius\"", "value"))[0];
+    assert!(close(rho, 224f64.sqrt() * 5f64.to_radians().sin(), 1e-9), "radius {rho}");
+    for radiance in numbers(&attr(&xml, sphere, "name=\"radiance\"", "value")) {
+        assert!(close(radiance * std::f64::consts::PI * rho * rho, 80.0, 1e-9), "radiance {radiance}");
+    }
+    assert!(!xml.contains("<emitter type=\"point\""));
     // The camera render would use (framing the box), scaled to mm.
     let settings = translucent::settings::RenderSettings::new(
         translucent::settings::SceneSettings { mesh: Some("box".into()), scale: 4.0, ..Default::default() }
@@ -192,6 +200,7 @@ fn spot_lights_are_mitsubas_spot_emitters() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(0), "{err}");
     assert!(err.contains("spot") && err.contains("smoothstep in cos θ"), "the falloff warned about: {err}");
+    assert!(err.contains("lights no translucent object"), "the delta spot's black subsurface warned about: {err}");
     let xml = std::fs::read_to_string(dir.join("scene.xml")).unwrap();
     assert_eq!(numbers(&attr(&xml, "<emitter type=\"spot\"", "<lookat", "origin")), vec![0.0, 12.0, 0.0]);
     assert_eq!(numbers(&attr(&xml, "<emitter type=\"spot\"", "<lookat", "target")), vec![0.0, 11.0, 0.0]);

@@ -17,8 +17,15 @@
 //!   unidirectional integrators (no path from inside the medium can connect to it). δ = 5° by
 //!   default. The disk lies beyond the camera's far clip, so the camera never sees it directly
 //!   (translucent does not draw lights either).
-//! - A point light of intensity I (per scene unit², E = I / d²) becomes a `point` emitter with
-//!   intensity I × (mm per unit)².
+//! - A point light of intensity I (per scene unit², E = I / d²; I × (mm per unit)² in mm) becomes
+//!   a small sphere of radius ρ emitting radiance I / (πρ²): a sphere's intensity toward every
+//!   direction is L πρ², and the irradiance it gives at distance d > ρ is I / d² exactly. A delta
+//!   `point` emitter behind a smooth dielectric renders black as a directional one does (an
+//!   export of the default bunny under a point light: its path-traced mean was exactly 0). ρ is
+//!   D sin δ (D the light's distance from the objects' centre: the sphere is seen from there as
+//!   the directional disks are), at most half its distance from the objects' bounding sphere.
+//! - A spot light becomes Mitsuba's delta `spot` (no area emitter has its cone), which lights only
+//!   opaque objects: a warning says so when there is a translucent one.
 //! - The camera is a `perspective` sensor with the vertical field of view (`fov_axis` y, aspect
 //!   width / height as the renderer's projection), a box reconstruction filter (a pixel is the mean
 //!   over its area) and an RGBA film: alpha is coverage, as in translucent's EXR output.
@@ -324,6 +331,15 @@ pub fn homogeneous(m: &Medium) -> Homogeneous {
 /// near 1 (that slab: 25× the time).
 pub const NO_ROULETTE: u32 = 1 << 30;
 
+/// The radius (mm) of the sphere that stands in for a point light at `position` (mm): seen from
+/// the objects' bounding sphere's centre at angular radius `radius_deg`, and at most half the
+/// light's distance from that sphere (a thousandth of its radius when the light is inside it).
+pub fn point_light_sphere(position: DVec3, (centre, radius): (DVec3, f64), radius_deg: f64) -> f64 {
+    let d = position.distance(centre);
+    let seen = d * radius_deg.to_radians().sin();
+    if d > radius { seen.min(0.5 * (d - radius)) } else { seen.min(1e-3 * radius) }.max(1e-9 * radius)
+}
+
 /// The radiance of a disk of angular radius `radius_deg` that gives irradiance `e` at normal
 /// incidence: E = π L sin²δ.
 pub fn disk_radiance(e: f64, radius_deg: f64) -> f64 {
@@ -561,17 +577,35 @@ pub fn write_scene(
                 let _ = writeln!(w, "    </shape>");
             }
             Light::Point { position, intensity } => {
-                let _ = writeln!(w, "    <!-- light {i}: point -->");
-                let _ = writeln!(w, "    <emitter type=\"point\" id=\"light{i}\">");
+                let sphere = point_light_sphere(position, (centre, radius), options.light_radius_deg);
+                if position.distance(centre) <= radius {
+                    written.warnings.push(format!(
+                        "light {i}: point: it lies within the objects' bounds; its sphere (radius {} mm) may meet them",
+                        num(sphere)
+                    ));
+                }
+                let radiance = intensity.map(|v| v / (std::f64::consts::PI * sphere * sphere));
                 let _ = writeln!(
                     w,
-                    "        <point name=\"position\" x=\"{}\" y=\"{}\" z=\"{}\"/>",
+                    "    <!-- light {i}: point, intensity {}: a sphere of radius {} mm emitting I/(pi r^2) -->",
+                    triple(intensity),
+                    num(sphere)
+                );
+                let _ = writeln!(w, "    <shape type=\"sphere\" id=\"light{i}\">");
+                let _ = writeln!(
+                    w,
+                    "        <point name=\"center\" x=\"{}\" y=\"{}\" z=\"{}\"/>",
                     num(position.x),
                     num(position.y),
                     num(position.z)
                 );
-                let _ = writeln!(w, "        <rgb name=\"intensity\" value=\"{}\"/>", triple(intensity));
-                let _ = writeln!(w, "    </emitter>");
+                let _ = writeln!(w, "        <float name=\"radius\" value=\"{}\"/>", num(sphere));
+                let _ = writeln!(
+                    w,
+                    "        <emitter type=\"area\"><rgb name=\"radiance\" value=\"{}\"/></emitter>",
+                    triple(radiance)
+                );
+                let _ = writeln!(w, "    </shape>");
             }
             Light::Spot { position, axis, intensity, cone_deg, delta_deg } => {
                 // Mitsuba 3's `spot` (src/emitters/spot.cpp) ramps linearly in the angle from
@@ -597,6 +631,11 @@ pub fn write_scene(
                 let _ = writeln!(w, "        <float name=\"cutoff_angle\" value=\"{}\"/>", num(cone_deg));
                 let _ = writeln!(w, "        <float name=\"beam_width\" value=\"{}\"/>", num(cone_deg - delta_deg));
                 let _ = writeln!(w, "    </emitter>");
+                if objects.iter().any(|o| !matches!(o.surface, Surface::Diffuse { .. })) {
+                    written.warnings.push(format!(
+                        "light {i}: spot: Mitsuba's delta `spot` behind a smooth dielectric lights no translucent object (no path from inside the medium can connect to it): only opaque objects see it; compare translucent ones under point or directional lights"
+                    ));
+                }
                 if delta_deg > 0.0 {
                     written.warnings.push(format!(
                         "light {i}: spot: Mitsuba's falloff over the outer {}° of its {}° cone is linear in the angle, translucent's (pbrt-v4's) a smoothstep in cos θ: the images differ on that rim",
