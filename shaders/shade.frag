@@ -513,20 +513,19 @@ vec3 single_scattering(vec3 xo, vec3 no, vec3 wo) {
                     unproject = inverse(layer_matrix(layer));
                     cached_layer = layer;
                 }
-                float h, cos_l, miss;
-                // The curvature where the light enters (the pixel's where the map sees no entry):
-                // at the base of the bunny's ear the pixel is concave where the entry, on the
-                // ear's back, is convex; there the pixel's gave single scattering 0.80 0.82 0.82
-                // of the path tracer's, the entry's 0.84 0.85 0.84.
-                float entry_curvature_mm = pixel_curvature_mm;
-                if (!light_entry(x, uv, layer, unproject, toward, eta, h, cos_l, miss, entry_curvature_mm)) {
+                float h, cos_l, miss, entry_curvature;
+                bool entered = light_entry(x, uv, layer, unproject, toward, eta, h, cos_l, miss, entry_curvature);
+                // The beam focuses by the curvature where the light enters (the pixel's where the
+                // map sees no entry): at the base of the bunny's ear the pixel is concave where
+                // the entry, on the ear's back, is convex; there the pixel's gave single
+                // scattering 0.80 0.82 0.82 of the path tracer's, the entry's 0.84 0.85 0.84.
+                float lens_curvature_mm = entered ? entry_curvature / mm : pixel_curvature_mm;
+                if (!entered) {
                     // No surface around it in the map (its edge): the pixel's own, straight.
-                    entry_curvature_mm = pixel_curvature_mm;
                     vec4 p = unproject * vec4(ndc.xy, depth, 1.0);
                     cos_l = abs(dot(no, toward));
                     h = max(dot(p.xyz / p.w - x, toward), 0.0) * cos_l;
                 } else {
-                    entry_curvature_mm /= mm;
                     // The bias at this entry (its slope held at tan θl ≤ 8: the band a few
                     // texels, not the whole way to a grazing surface), for this sample's depth
                     // difference and the next ones'.
@@ -551,7 +550,7 @@ vec3 single_scattering(vec3 xo, vec3 no, vec3 wo) {
                 float reached = 1.0 - smoothstep(tolerance, 2.0 * tolerance, miss);
                 // The beam's flux inside per unit area across it (its irradiance at normal incidence outside).
                 beam = enters ? reached * incident * cos_l * fresnel_transmittance(eta, cos_l) / cos_t : vec3(0.0);
-                if (enters) beam *= lens_gain(h * mm / cos_t, cos_l, cos_t, eta, entry_curvature_mm);
+                if (enters) beam *= lens_gain(h * mm / cos_t, cos_l, cos_t, eta, lens_curvature_mm);
             }
             float ds = s - s_prev;
             if (k > 0u && inside && inside_prev) {

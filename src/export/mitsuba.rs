@@ -334,7 +334,7 @@ pub const NO_ROULETTE: u32 = 1 << 30;
 /// The radius (mm) of the sphere that stands in for a point light at `position` (mm): seen from
 /// the objects' bounding sphere's centre at angular radius `radius_deg`, and at most half the
 /// light's distance from that sphere (a thousandth of its radius when the light is inside it).
-pub fn point_light_sphere(position: DVec3, (centre, radius): (DVec3, f64), radius_deg: f64) -> f64 {
+fn point_light_sphere(position: DVec3, (centre, radius): (DVec3, f64), radius_deg: f64) -> f64 {
     let d = position.distance(centre);
     let seen = d * radius_deg.to_radians().sin();
     if d > radius { seen.min(0.5 * (d - radius)) } else { seen.min(1e-3 * radius) }.max(1e-9 * radius)
