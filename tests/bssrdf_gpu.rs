@@ -145,11 +145,11 @@ fn gpu_table_models_match_cpu() {
 }
 
 /// The Monte Carlo table's curvature terms as the shade pass reads them (bssrdf.glsl
-/// `curvature_rows` + `curvature_ratio`, `curvature_exit`, `exit_tilt`; f16 texels, f32
-/// arithmetic) against their Rust mirrors (`CurvatureRatios::lookup`, `lookup_exit`,
-/// `exit_tilt_at`; the same f16 values in f64), for Skin1: random chords out to 30 L, curvatures
+/// `curvature_rows` + `curvature_ratio`, `curvature_exit`, `exit_tilt`, `azimuth_harmonics`; f16
+/// texels, f32 arithmetic) against their Rust mirrors (`CurvatureRatios::lookup`, `lookup_exit`,
+/// `exit_tilt_at`, `harmonics_at`; the same f16 values in f64), for Skin1: random chords out to 30 L, curvatures
 /// of both signs from L/64 to 16 L (past the last node too) and flat, exit cosines and far
-/// shares. Within 1e-5 relative (the tilt, which crosses 0, 1e-5 absolute and relative; measured
+/// shares. Within 1e-5 relative (the tilt and the harmonics, which cross 0, 1e-5 absolute and relative; measured
 /// 8e-7 for the ratio, 2e-7 for the exit's, the tilt exact), except where the nearest entry's
 /// index lies within 1e-4 of a boundary (f32 and f64 may round apart). It found the Rust mirror
 /// of f16 dropping the sign (the tilt's g is negative near the entry).
@@ -195,24 +195,25 @@ fn gpu_curvature_terms_match_cpu() {
         .collect();
 
     let (ctx, counts) = validated_context();
+    const TERMS: usize = 6;
     let results: Vec<[f32; 4]> = {
         let pipeline = Pipeline::compute(&ctx, "test/curvature_terms.comp").unwrap();
         let table = vk::upload_buffer(&ctx, "table", &texels, BufferUsageFlags::UNIFORM_TEXEL_BUFFER).unwrap();
         let input = vk::upload_buffer(&ctx, "queries", &queries, BufferUsageFlags::STORAGE_BUFFER).unwrap();
         let usage = BufferUsageFlags::STORAGE_BUFFER | BufferUsageFlags::TRANSFER_SRC;
-        let output = Buffer::new(&ctx, "results", 64 * n as u64, usage, MemoryLocation::GpuOnly).unwrap();
+        let output = Buffer::new(&ctx, "results", (16 * TERMS * n) as u64, usage, MemoryLocation::GpuOnly).unwrap();
         let binds = [Bind::Read(&input), Bind::Write(&output), Bind::Texels(&table)];
         let count = n as u32;
         ctx.submit(None, |rec| rec.dispatch(&pipeline, &binds, bytemuck::bytes_of(&count), [count.div_ceil(64), 1, 1]))
             .unwrap();
-        vk::download_buffer(&ctx, &output, 4 * n).unwrap()
+        vk::download_buffer(&ctx, &output, TERMS * n).unwrap()
     };
     drop(ctx);
     assert_clean(&counts);
 
     // How near an entry boundary the nearest-entry read falls (f32 against f64).
     let near_boundary = |x: f64| x > 0.5 && (x - x.round()).abs() < 1e-4;
-    let (mut checked, mut worst) = (0, [0.0f64; 4]);
+    let (mut checked, mut worst) = (0, [0.0f64; TERMS]);
     for (i, q) in queries.iter().enumerate() {
         let [r, kappa, cos_o, far] = q.map(|v| v as f64);
         let held = kappa.abs().min(curvature_profile::last_curvature(unit));
@@ -222,10 +223,11 @@ fn gpu_curvature_terms_match_cpu() {
             continue;
         }
         let [c, g] = ratios.exit_tilt_at(r);
-        let cpu = [ratios.lookup(r, kappa), ratios.lookup_exit(cos_o, kappa, far), c, g];
+        let [b2, b3] = ratios.harmonics_at(r);
+        let cpu = [ratios.lookup(r, kappa), ratios.lookup_exit(cos_o, kappa, far), c, g, b2, b3];
         for (k, expected) in cpu.iter().enumerate() {
             for ch in 0..3 {
-                let gpu = results[4 * i + k][ch] as f64;
+                let gpu = results[TERMS * i + k][ch] as f64;
                 let e = expected[ch];
                 // Relative for the ratios, absolute for the tilt.
                 let err = if k >= 2 { (gpu - e).abs() } else { (gpu - e).abs() / e.abs().max(1e-6) };
@@ -240,8 +242,8 @@ fn gpu_curvature_terms_match_cpu() {
         checked += 1;
     }
     println!(
-        "{checked} queries; worst ratio {:.1e}, exit {:.1e}, c {:.1e}, g {:.1e}",
-        worst[0], worst[1], worst[2], worst[3]
+        "{checked} queries; worst ratio {:.1e}, exit {:.1e}, c {:.1e}, g {:.1e}, b₂ {:.1e}, b₃ {:.1e}",
+        worst[0], worst[1], worst[2], worst[3], worst[4], worst[5]
     );
     assert!(checked > n * 9 / 10, "only {checked} of {n} queries checked");
 }

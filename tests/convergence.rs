@@ -136,6 +136,9 @@ fn default_images_converge_on_a_sphere() {
         // the variate, lit by the pixel's own irradiance alone, cannot take (brute force over the
         // 11,150 points with the near field 0.26 / 0.30 / 0.43%, was 0.24 / 0.28 / 0.33%; eight
         // angles in the disk instead of four: 0.43%). So blue's gain is held at 0.5, not 0.4.
+        // With the lean's second and third harmonics (2026-12-07) 0.81 / 0.67 / 0.56% against
+        // 0.81 / 0.77 / 1.24% without the near field, its disk taking eight angles (four, exact
+        // for the lean times the tilt no more: 0.80 / 0.75 / 0.81%, blue's gain 0.65).
         // (0.77 / 0.58 / 0.37% before the tilt.)
         // (0.61 / 0.37 / 0.34% before each node was read at the same place on its ball; the
         // sigma points then kept the node's normal, 0.65 / 0.81 / 0.49%: see sources.glsl

@@ -246,12 +246,13 @@ fn between_nodes_the_ratio_reads_each_ball_at_the_same_place() {
 
 /// A 10 mm Skin1 sphere under light along −z, by the walk: the exitance of two or more
 /// scatterings within 10° of the pole, against the renderer's sum over the lit hemisphere.
-/// Measured: 0.936 / 0.94 / 1.01 (R / G / B; the walk's noise 1.3-3%), the flat half-space 0.86 /
-/// 0.87 / 0.97. Red was 0.95 when the ratio was read between nodes at one chord, which
-/// overstated the middle chords by 4-17% (`between_nodes_the_ratio_reads_each_ball_at_the_same_place`);
-/// read right, what is left is the azimuthal shape of an oblique beam's light on a ball beyond
-/// the first harmonic (about 4% at the pole: `the_ball_s_own_oblique_beams_sum_to_the_walk`),
-/// so the bound is 7%, not the 6% that the two errors once met together.
+/// Measured: 0.979 / 0.975 / 0.998 (R / G / B; the walk's noise 1.3-3%), the flat half-space
+/// 0.86 / 0.87 / 0.92. With the lean's first harmonic alone it was 0.936 / 0.94 / 1.01: every
+/// source's light reaches the pole from behind its beam, where that harmonic left 0.68–0.90 of
+/// the walk's (`an_oblique_beam_s_light_follows_the_walk_around_it`); the second and third
+/// harmonics give it back. (Red was 0.95 before when the ratio was read between nodes at one
+/// chord, which overstated the middle chords by 4-17%:
+/// `between_nodes_the_ratio_reads_each_ball_at_the_same_place`.) Within 4%.
 #[test]
 fn the_front_lit_sphere_at_its_pole_matches_the_walk() {
     let media = skin1();
@@ -293,7 +294,7 @@ fn the_front_lit_sphere_at_its_pole_matches_the_walk() {
                 * theta.sin()
                 * (PI / 2.0 / steps as f64);
             flat += weight * profile.exitance(chord);
-            let lean = (1.0 - profile.azimuth_factor(chord) * sin_t).max(0.0);
+            let lean = profile.lean(chord, -sin_t, sin_t * sin_t);
             curved += weight * profile.exitance(chord) * lean * curvature[c].ratio(chord, 1.0 / r_mm);
         }
         println!(
@@ -302,7 +303,7 @@ fn the_front_lit_sphere_at_its_pole_matches_the_walk() {
             flat / truth,
             curved / truth
         );
-        assert!((curved / truth - 1.0).abs() < 0.07, "channel {c}: model {:.3} of the walk", curved / truth);
+        assert!((curved / truth - 1.0).abs() < 0.04, "channel {c}: model {:.3} of the walk", curved / truth);
         if c < 2 {
             assert!(flat / truth < 0.93, "channel {c}: the flat half-space {:.3} of the walk", flat / truth);
         }
@@ -368,8 +369,9 @@ fn ring_sums(m: &Medium, r_mm: f64, steps: usize, term: impl Fn(f64, f64, f64) -
 }
 
 /// [`ring_sums`] of the renderer's term (each source's half-space profile at the chord, its
-/// incidence factor, its lean, the ratio at the chord), multiplied by `incidence(cos θi, chord)`
-/// (1: the renderer's) and with its lean's harmonic b(chord) replaced by `harmonic` when given.
+/// incidence factor, its lean's harmonics, the ratio at the chord), multiplied by
+/// `incidence(cos θi, chord)` (1: the renderer's) and with its lean replaced by the first
+/// harmonic `harmonic(chord)` alone when given.
 fn rings(
     m: &Medium,
     ratios: &curvature_profile::CurvatureChannel,
@@ -381,8 +383,10 @@ fn rings(
     ring_sums(m, r_mm, 400, |cos_i, chord, cos_phi| {
         let cos_t = (1.0 - (1.0 - cos_i * cos_i) / (m.eta * m.eta)).max(0.0).sqrt();
         let sin_t = (1.0 - cos_t * cos_t).sqrt();
-        let b: f64 = harmonic.map_or_else(|| profile.azimuth_factor(chord), |h| h(chord));
-        let lean = (1.0 + b * sin_t * cos_phi).max(0.0);
+        let lean = match harmonic {
+            Some(h) => (1.0 + h(chord) * sin_t * cos_phi).max(0.0),
+            None => profile.lean(chord, sin_t * cos_phi, sin_t * sin_t),
+        };
         profile.incidence_factor(cos_t)
             * profile.exitance(chord)
             * lean
@@ -662,5 +666,133 @@ fn the_ball_s_own_oblique_beams_sum_to_the_walk() {
             line += &format!(" {}°: {:.3} ({:.3})", 5 + 10 * k, full[k], cut[k]);
         }
         println!("{line}");
+    }
+}
+
+/// The light of two or more scatterings around an oblique beam, by sector of azimuth from the
+/// refracted beam's way along the surface (ahead 0–60°, the sides 60–120°, behind 120–180°) and
+/// band of chord: the model's M(r) f(θt) lean(r, φ) C(r; κ) over the exact walk's, for `photons`
+/// photons entering at cos θi (the ball of radius `r_mm` when given, else the flat half-space).
+fn sector_ratios(
+    m: &Medium,
+    cos_i: f64,
+    ball: Option<(&curvature_profile::CurvatureChannel, f64)>,
+    bands: &[(f64, f64)],
+    photons: u64,
+) -> Vec<[Option<f64>; 3]> {
+    let sigma_t = m.sigma_a + m.sigma_s * (1.0 - m.g);
+    let albedo = m.sigma_s * (1.0 - m.g) / sigma_t;
+    let start = halfspace::entry_direction(m.eta, cos_i);
+    let profile = McProfile::of(m);
+    let cos_t = (1.0 - (1.0 - cos_i * cos_i) / (m.eta * m.eta)).sqrt();
+    let sin_t = (1.0 - cos_t * cos_t).sqrt();
+    let mut counts = vec![[0u64; 3]; bands.len()];
+    for p in 0..photons {
+        let seed = 0x5ec7 ^ p.wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        let mut tally = |x: DVec3, n: u32| {
+            let chord = x.length() / sigma_t;
+            let sector = ((x.y.atan2(x.x).abs() / PI * 3.0) as usize).min(2);
+            if let Some(b) = bands.iter().position(|&(a, z)| chord >= a && chord < z) {
+                if n >= 2 {
+                    counts[b][sector] += 1;
+                }
+            }
+        };
+        match ball {
+            Some((_, r_mm)) => sphere::trace_sphere(albedo, m.eta, r_mm * sigma_t, start, 1, (seed, 100_000), |e| {
+                tally(e.position, e.scatterings)
+            }),
+            None => halfspace::trace_half_space(albedo, m.eta, start, 1, (seed, 100_000), |e| {
+                tally(DVec3::new(e.x, e.y, 0.0), e.scatterings)
+            }),
+        };
+    }
+    let steps = 48;
+    bands
+        .iter()
+        .zip(&counts)
+        .map(|(&(c0, c1), count)| {
+            std::array::from_fn(|sector| {
+                let mut model = 0.0;
+                for i in 0..steps {
+                    for j in 0..steps {
+                        let r = c0 + (i as f64 + 0.5) / steps as f64 * (c1 - c0);
+                        let phi = (sector as f64 + (j as f64 + 0.5) / steps as f64) * PI / 3.0;
+                        let ratio = ball.map_or(1.0, |(c, r_mm)| c.ratio(r, 1.0 / r_mm));
+                        // Both halves of the sector (φ and −φ): 2 r dr dφ.
+                        model += profile.exitance(r)
+                            * profile.incidence_factor(cos_t)
+                            * profile.lean(r, sin_t * phi.cos(), sin_t * sin_t)
+                            * ratio
+                            * 2.0
+                            * r
+                            * (c1 - c0)
+                            / steps as f64
+                            * (PI / 3.0)
+                            / steps as f64;
+                    }
+                }
+                (count[sector] >= 50).then(|| model / (count[sector] as f64 / photons as f64))
+            })
+        })
+        .collect()
+}
+
+/// An oblique beam's light has the shape around it that the model gives: on the flat
+/// half-space, per chord band, the model's light over the walk's is the same ahead of the beam,
+/// to its sides and behind it within 20% (the largest sector over the smallest; Skin1, every
+/// channel, entering at cos θi 0.2 and 0.5, chords 0.6–1.25 and 1.25–3.1 mm). Light entering
+/// obliquely is peaked ahead of its beam and flat behind it. With the first harmonic alone
+/// (1 + b sin θt cos φ) the sectors were 0.81–0.97 of the walk ahead, 1.09–1.30 to the sides
+/// and 0.68–0.90 behind, spreads 1.26–1.87. With the second and third harmonics
+/// (McProfile::harmonics) the spreads are 1.02–1.07 in red and green and 1.05–1.17 in blue
+/// (its sides 0.82–0.85 at 1.25–3.1 mm: higher harmonics). What is left between bands (0.88–0.97
+/// at 1.25–3.1 mm, 0.92–1.03 nearer) is the radial profile at oblique incidence, which the
+/// model takes as the normal beam's times f(θt).
+#[test]
+fn an_oblique_beam_s_light_follows_the_walk_around_it() {
+    let media = skin1();
+    let bands = [(0.6, 1.25), (1.25, 3.1)];
+    for cos_i in [0.2, 0.5] {
+        for (c, m) in media.iter().enumerate() {
+            let ratios = sector_ratios(m, cos_i, None, &bands, 300_000);
+            for (b, r) in ratios.iter().enumerate() {
+                let r: Vec<f64> = r.iter().map(|v| v.expect("escapes in every sector")).collect();
+                let spread = r.iter().cloned().fold(f64::MIN, f64::max) / r.iter().cloned().fold(f64::MAX, f64::min);
+                println!(
+                    "cos θi {cos_i} channel {c} band {:?}: ahead / sides / behind {:.3?} (spread {spread:.3})",
+                    bands[b], r
+                );
+                assert!(spread < 1.2, "cos θi {cos_i} channel {c} band {:?}: {:.3?}", bands[b], r);
+            }
+        }
+    }
+}
+
+/// The same on a 10 mm ball too, every band out to its diameter (a diagnostic, printed):
+/// `cargo test --release --test curvature_profile -- --ignored --nocapture an_oblique_beam`
+/// (a few minutes). Measured with the lean's first harmonic alone (Skin1, cos θi 0.4): near the
+/// entry as the flat half-space; past 7 mm (toward the entry's antipode) red's ahead was
+/// 1.25–1.9 of the walk. A beam's shift along the surface lengthens or shortens only the chord's part
+/// along the surface, and a chord toward the antipode runs through the ball.
+#[test]
+#[ignore]
+fn an_oblique_beam_s_light_by_sector_on_a_ball() {
+    let media = skin1();
+    let curvature = curvature_profile::of_channels(&media);
+    let bands = [(0.0, 0.6), (0.6, 1.25), (1.25, 3.1), (3.1, 6.0), (6.0, 8.0), (8.0, 10.0)];
+    for cos_i in [0.2, 0.4, 0.8] {
+        for c in 0..3 {
+            for ball in [None, Some((&*curvature[c], 5.0))] {
+                let ratios = sector_ratios(&media[c], cos_i, ball, &bands, 1_000_000);
+                let mut line = format!("cos θi {cos_i} channel {c} {}:", if ball.is_some() { "ball" } else { "flat" });
+                for (&(c0, c1), r) in bands.iter().zip(&ratios) {
+                    let shown: Vec<String> =
+                        r.iter().map(|v| v.map_or("  -  ".into(), |x| format!("{x:.2}"))).collect();
+                    line += &format!(" | {c0}-{c1} mm {}", shown.join(" "));
+                }
+                println!("{line}");
+            }
+        }
     }
 }

@@ -68,6 +68,15 @@ fn ketchup_thin_slab_against_the_path_tracer() {
 /// selection moves a back-lit mean by 4%). Each case is held to its measured ratio within 4%
 /// so that it fails if the model moves either way: a fix of a
 /// deficit updates the numbers here, with its cause.
+/// - **The lean's second and third harmonics** (2026-12-07, `McProfile::harmonics`): an oblique
+///   beam's light is peaked ahead of it and flat behind it, where the first harmonic alone left
+///   0.68–0.90 of the walk's behind and 1.09–1.30 to the sides (tests/curvature_profile.rs).
+///   Skin1 sphere front-lit 0.981 0.980 0.986 → 1.002 0.998 0.997, back-lit 1.055 0.969 0.933 →
+///   1.057 0.982 0.953; the torus 0.992 0.988 0.999 → 1.004 1.000 1.008 and 1.070 1.017 0.981 →
+///   1.072 1.025 0.993; the box 1.150 1.045 0.967 → 1.157 1.055 0.977; Potato front-lit 0.995
+///   0.998 0.973 → 1.014 1.018 1.001, back-lit 1.035 1.049 1.049 → 1.037 1.050 1.052; Marble
+///   +0.3–0.4%; the bunnies within 0.2%; every slab unchanged (the harmonics sum to nothing on a
+///   flat surface lit evenly).
 /// - **The beam focuses by the entry's curvature** (2026-12-07, the shadow pass's curvature
 ///   layer, shade.frag `lens_gain`): the Skin1 bunny 1.050 0.922 0.872 → 1.055 0.928 0.880 (its
 ///   single scattering 0.802 0.819 0.816 → 0.837 0.847 0.838), the back-lit torus 1.072 1.019
@@ -147,17 +156,17 @@ fn ketchup_thin_slab_against_the_path_tracer() {
 fn curved_objects_against_the_path_tracer() {
     let brute = ["--brute-force", "--samples", "100000"];
     let cases: [(&str, &[&str], [f64; 3]); 11] = [
-        ("skin1/sphere-front", &brute, [0.981, 0.980, 0.986]),
-        ("skin1/sphere-back", &brute, [1.055, 0.969, 0.933]),
-        ("skin1/box-back", &brute, [1.150, 1.045, 0.966]),
-        ("skin1/torus-front", &brute, [0.992, 0.988, 0.999]),
-        ("skin1/torus-back", &brute, [1.070, 1.017, 0.981]),
-        ("skin1/bunny", &[], [1.055, 0.928, 0.880]),
-        ("marble/bunny", &[], [1.037, 1.015, 0.969]),
-        ("potato/sphere-front", &[], [0.995, 0.998, 0.973]),
-        ("marble/sphere-front", &[], [1.007, 1.003, 1.001]),
-        ("potato/sphere-back", &[], [1.035, 1.049, 1.049]),
-        ("marble/sphere-back", &[], [1.003, 1.021, 1.015]),
+        ("skin1/sphere-front", &brute, [1.002, 0.998, 0.997]),
+        ("skin1/sphere-back", &brute, [1.057, 0.982, 0.953]),
+        ("skin1/box-back", &brute, [1.157, 1.055, 0.977]),
+        ("skin1/torus-front", &brute, [1.004, 1.000, 1.008]),
+        ("skin1/torus-back", &brute, [1.072, 1.025, 0.993]),
+        ("skin1/bunny", &[], [1.053, 0.927, 0.880]),
+        ("marble/bunny", &[], [1.038, 1.015, 0.969]),
+        ("potato/sphere-front", &[], [1.014, 1.018, 1.001]),
+        ("marble/sphere-front", &[], [1.011, 1.007, 1.004]),
+        ("potato/sphere-back", &[], [1.037, 1.050, 1.052]),
+        ("marble/sphere-back", &[], [1.006, 1.024, 1.018]),
     ];
     for (name, sampling, expected) in cases {
         for (ch, ratio) in mc_against_its_reference(name, sampling).into_iter().enumerate() {
@@ -260,7 +269,8 @@ fn single_scattering_on_the_bunny_against_the_path_tracer() {
 /// 1 there, from above and in front), its light scattered once and all of it, against the path
 /// tracer (`export mitsuba` writes a point light as a small sphere emitting I/(πρ²): a delta
 /// point light behind a smooth dielectric renders black in Mitsuba). Single scattering measured
-/// 0.954 0.963 0.969, the whole image 1.021 0.972 0.966; each held to its recorded ratio within 4%,
+/// 0.954 0.963 0.969, the whole image 1.027 0.978 0.971 (1.021 0.972 0.966 with the lean's first
+/// harmonic alone); each held to its recorded ratio within 4%,
 /// single scattering within 10% of the path tracer. With six cube faces for a far point light
 /// (before 2026-12-07), where the bunny covered 20 × 35 texels of one, single scattering was
 /// 0.051 0.046 0.043 of the path tracer's (0.833 0.682 0.550 the whole).

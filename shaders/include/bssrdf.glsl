@@ -224,15 +224,32 @@ vec3 curvature_exit(usamplerBuffer table, vec4 rows, float cos_o, float far) {
 // after the curvature rows and the exit rows, EXIT_TILT_ENTRIES texels of f16 pairs (c_r, c_g),
 // (c_b, g_r), (g_g, g_b) at the centres of u = r/(r + L), the nearest read; `unit_mm` = L (0:
 // none, the other models).
+const int EXIT_TILT_BASE =
+    CURVATURE_BASE + 1 + 2 * int(CURVATURE_NODES * CURVATURE_TABLE_ENTRIES) + 4 * int(CURVATURE_NODES * MC_EXIT_BINS);
+int exit_entry(float unit_mm, float r_mm) {
+    return min(int(r_mm / (r_mm + unit_mm) * float(EXIT_TILT_ENTRIES)), int(EXIT_TILT_ENTRIES) - 1);
+}
+// Six f16 of texel `t` as two vec3: (a_r, a_g), (a_b, b_r), (b_g, b_b).
+void two_rgb_halves(usamplerBuffer table, int t, out vec3 a, out vec3 b) {
+    uvec3 pairs = texelFetch(table, t).xyz;
+    vec2 p = unpackHalf2x16(pairs.x), q = unpackHalf2x16(pairs.y), w = unpackHalf2x16(pairs.z);
+    a = vec3(p.x, p.y, q.x);
+    b = vec3(q.y, w.x, w.y);
+}
 void exit_tilt(usamplerBuffer table, float unit_mm, float r_mm, out vec3 c, out vec3 g) {
     c = g = vec3(0.0);
     if (!(unit_mm > 0.0)) return;
-    int base = CURVATURE_BASE + 1 + 2 * int(CURVATURE_NODES * CURVATURE_TABLE_ENTRIES) + 4 * int(CURVATURE_NODES * MC_EXIT_BINS);
-    int e = min(int(r_mm / (r_mm + unit_mm) * float(EXIT_TILT_ENTRIES)), int(EXIT_TILT_ENTRIES) - 1);
-    uvec3 pairs = texelFetch(table, base + e).xyz;
-    vec2 a = unpackHalf2x16(pairs.x), b = unpackHalf2x16(pairs.y), d = unpackHalf2x16(pairs.z);
-    c = vec3(a.x, a.y, b.x);
-    g = vec3(b.y, d.x, d.y);
+    two_rgb_halves(table, EXIT_TILT_BASE + exit_entry(unit_mm, r_mm), c, g);
+}
+
+// The Monte Carlo table's higher azimuthal harmonics b₂, b₃ per channel at distance r (mirrors
+// gpu::sd_table::CurvatureRatios::harmonics_at, physics::mc_profile::McProfile::higher_harmonics):
+// EXIT_TILT_ENTRIES texels after the exit tilt, the same entries, f16 pairs (b₂_r, b₂_g),
+// (b₂_b, b₃_r), (b₃_g, b₃_b); 0 without the table (`unit_mm` 0).
+void azimuth_harmonics(usamplerBuffer table, float unit_mm, float r_mm, out vec3 b2, out vec3 b3) {
+    b2 = b3 = vec3(0.0);
+    if (!(unit_mm > 0.0)) return;
+    two_rgb_halves(table, EXIT_TILT_BASE + int(EXIT_TILT_ENTRIES) + exit_entry(unit_mm, r_mm), b2, b3);
 }
 
 // The ray-source term S'(x, w, r) of the directional dipole.

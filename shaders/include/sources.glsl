@@ -64,10 +64,12 @@ vec3 exit_along = vec3(0.0);
 vec3 exit_normal = vec3(0.0, 0.0, 1.0);
 
 // The Monte Carlo table's multiple scattering at xo from a source at (xi, ni) lit from the mean
-// directions `toward[c]` (per channel, toward the lights, per unit power): Sp(r)·(1 + b(r) m·d̂),
-// the azimuthal harmonic of the light's lean, m = −(toward's part along the surface)/η the
-// refracted direction's part along it (|m| = sin θt for one light, shorter where lights
-// differ) and d̂ the direction to xo along xi's surface (so m·d̂ = −toward·d̂/η), times the
+// directions `toward[c]` (per channel, toward the lights, per unit power): Sp(r) times the
+// azimuthal harmonics of the light's lean, 1 + b x + b₂(2x² − s²) + b₃(4x³ − 3xs²) ≥ 0
+// (McProfile::lean: sin θt cos φ, sin²θt cos 2φ and sin³θt cos 3φ written in m), x = m·d̂ and
+// s² = |m|², m = −(toward's part along the surface)/η the refracted direction's part along it
+// (|m| = sin θt for one light, shorter where lights differ) and d̂ the direction to xo along
+// xi's surface (so m·d̂ = −toward·d̂/η), times the
 // curvature ratio at curvature `kappa` (1/mm); r = |d|, d = xo − xi in mm. Times the exit's tilt
 // toward the eye, 1 + c(r) ωt·â + g(r) ωt·m (ωt = exit_along, â the way along the pixel's
 // surface away from the source): light leaves leaning away from where it entered, and near an
@@ -80,8 +82,14 @@ vec3 mc_sd(vec3 d, vec3 ni, float kappa, vec3 toward[3]) {
     float eta = object_params.channels[0].eta;
     float scale = len > 0.0 ? -1.0 / (eta * len) : 0.0;
     vec3 lean = scale * vec3(dot(toward[0], tangential), dot(toward[1], tangential), dot(toward[2], tangential));
-    vec3 b;
+    // |m|² per channel (0 where the pair has no direction along the surface: no harmonic).
+    vec3 m2 = len > 0.0 ? vec3(dot(toward[0], toward[0]) - dot(toward[0], ni) * dot(toward[0], ni),
+                               dot(toward[1], toward[1]) - dot(toward[1], ni) * dot(toward[1], ni),
+                               dot(toward[2], toward[2]) - dot(toward[2], ni) * dot(toward[2], ni)) / (eta * eta)
+                        : vec3(0.0);
+    vec3 b, b2, b3;
     vec3 sd = sd_table_azimuth(dipole_table, dipole_header, r, b);
+    azimuth_harmonics(dipole_table, pixel_curvature_rows.w, r, b2, b3);
     vec3 tilt = vec3(1.0);
     if (exit_along != vec3(0.0)) {
         vec3 c, g;
@@ -95,7 +103,8 @@ vec3 mc_sd(vec3 d, vec3 ni, float kappa, vec3 toward[3]) {
                                          dot(exit_along, toward[2] - dot(toward[2], ni) * ni));
         tilt = max(vec3(1.0) + c * radial + g * ahead, vec3(0.0));
     }
-    return sd * max(vec3(1.0) + b * lean, vec3(0.0)) * tilt
+    vec3 harmonics = vec3(1.0) + b * lean + b2 * (2.0 * lean * lean - m2) + b3 * (4.0 * lean * lean - 3.0 * m2) * lean;
+    return sd * max(harmonics, vec3(0.0)) * tilt
         * curvature_ratio(dipole_table, curvature_rows_at(pixel_curvature_rows.w, kappa), r);
 }
 

@@ -10,7 +10,7 @@ layout(local_size_x = 64) in;
 // Per query: the chord r (mm), the pair's curvature κ (1/mm), the exit cosine and the far
 // light's share.
 layout(std430, binding = 0) readonly buffer Queries { vec4 queries[]; };
-// Per query four: the ratio, the exit's ratio, the tilt's c and g (rgb).
+// Per query six: the ratio, the exit's ratio, the tilt's c and g, the harmonics b₂ and b₃ (rgb).
 layout(std430, binding = 1) writeonly buffer Results { vec4 results[]; };
 // An object's table (its curvature rows from CURVATURE_BASE).
 layout(binding = 2) uniform usamplerBuffer table;
@@ -21,10 +21,13 @@ void main() {
     if (i >= pc.count) return;
     vec4 q = queries[i];
     vec4 rows = curvature_rows(table, q.y);
-    vec3 c, g;
+    vec3 c, g, b2, b3;
     exit_tilt(table, rows.w, q.x, c, g);
-    results[4u * i] = vec4(curvature_ratio(table, rows, q.x), 0.0);
-    results[4u * i + 1u] = vec4(curvature_exit(table, rows, q.z, q.w), 0.0);
-    results[4u * i + 2u] = vec4(c, 0.0);
-    results[4u * i + 3u] = vec4(g, 0.0);
+    azimuth_harmonics(table, rows.w, q.x, b2, b3);
+    results[6u * i] = vec4(curvature_ratio(table, rows, q.x), 0.0);
+    results[6u * i + 1u] = vec4(curvature_exit(table, rows, q.z, q.w), 0.0);
+    results[6u * i + 2u] = vec4(c, 0.0);
+    results[6u * i + 3u] = vec4(g, 0.0);
+    results[6u * i + 4u] = vec4(b2, 0.0);
+    results[6u * i + 5u] = vec4(b3, 0.0);
 }

@@ -320,7 +320,8 @@ pub const EXIT_TILT_ENTRIES: usize = super::EXIT_TILT_ENTRIES as usize;
 /// Monte Carlo table's exit tilt [c, g] ([`McProfile::exit_tilt_at`]) at EXIT_TILT_ENTRIES
 /// centres of u = r/(r + L), one texel each: f16 pairs (c_r, c_g), (c_b, g_r), (g_g, g_b)
 /// (`exit_tilt`; it rides here, where L is read per pixel anyway, as the Sd table's texels have
-/// no word left).
+/// no word left). Then the higher azimuthal harmonics [b₂, b₃] ([`McProfile::higher_harmonics`])
+/// at the same centres, f16 pairs (b₂_r, b₂_g), (b₂_b, b₃_r), (b₃_g, b₃_b) (`azimuth_harmonics`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct CurvatureRatios {
     pub unit_mm: f32,
@@ -334,6 +335,8 @@ pub struct CurvatureRatios {
     pub concave_exit_far: Vec<Vec<[f32; 3]>>,
     /// Per entry, [c, g] per channel.
     pub exit_tilt: Vec<[[f32; 3]; 2]>,
+    /// Per entry, [b₂, b₃] per channel.
+    pub harmonics: Vec<[[f32; 3]; 2]>,
 }
 
 impl CurvatureRatios {
@@ -352,6 +355,7 @@ impl CurvatureRatios {
             convex_exit_far: flat_exit.clone(),
             concave_exit_far: flat_exit,
             exit_tilt: vec![[[0.0; 3]; 2]; EXIT_TILT_ENTRIES],
+            harmonics: vec![[[0.0; 3]; 2]; EXIT_TILT_ENTRIES],
         }
     }
 
@@ -398,6 +402,16 @@ impl CurvatureRatios {
         if unit.is_nan() || unit <= 0.0 {
             return CurvatureRatios::none();
         }
+        // Two values per channel (`at(channel, r)`) at the EXIT_TILT_ENTRIES centres of u = r/(r + L).
+        let per_exit_entry = |at: &dyn Fn(usize, f64) -> [f64; 2]| -> Vec<[[f32; 3]; 2]> {
+            (0..EXIT_TILT_ENTRIES)
+                .map(|i| {
+                    let u = (i as f64 + 0.5) / EXIT_TILT_ENTRIES as f64;
+                    let v = [0, 1, 2].map(|c| at(c, unit * u / (1.0 - u)));
+                    [0, 1].map(|j| v.map(|t| t[j] as f32))
+                })
+                .collect()
+        };
         CurvatureRatios {
             unit_mm: unit as f32,
             convex: nodes(1.0),
@@ -406,13 +420,8 @@ impl CurvatureRatios {
             concave_exit: exits(true, false),
             convex_exit_far: exits(false, true),
             concave_exit_far: exits(true, true),
-            exit_tilt: (0..EXIT_TILT_ENTRIES)
-                .map(|i| {
-                    let u = (i as f64 + 0.5) / EXIT_TILT_ENTRIES as f64;
-                    let tilt = [0, 1, 2].map(|c| profiles[c].exit_tilt_at(unit * u / (1.0 - u)));
-                    [0, 1].map(|j| tilt.map(|t| t[j] as f32))
-                })
-                .collect(),
+            exit_tilt: per_exit_entry(&|c, r| profiles[c].exit_tilt_at(r)),
+            harmonics: per_exit_entry(&|c, r| profiles[c].higher_harmonics(r)),
         }
     }
 
@@ -423,8 +432,22 @@ impl CurvatureRatios {
         if unit.is_nan() || unit <= 0.0 {
             return [[0.0; 3]; 2];
         }
-        let e = ((r_mm / (r_mm + unit) * EXIT_TILT_ENTRIES as f64) as usize).min(EXIT_TILT_ENTRIES - 1);
-        self.exit_tilt[e].map(|v| v.map(|x| half_value(half_bits(x))))
+        self.exit_tilt[Self::exit_entry(r_mm, unit)].map(|v| v.map(|x| half_value(half_bits(x))))
+    }
+
+    /// The higher azimuthal harmonics [b₂, b₃] per channel at distance `r_mm`, as the shade pass
+    /// reads them (`azimuth_harmonics`): the nearest entry, in f16; 0 without ratios.
+    pub fn harmonics_at(&self, r_mm: f64) -> [[f64; 3]; 2] {
+        let unit = self.unit_mm as f64;
+        if unit.is_nan() || unit <= 0.0 {
+            return [[0.0; 3]; 2];
+        }
+        self.harmonics[Self::exit_entry(r_mm, unit)].map(|v| v.map(|x| half_value(half_bits(x))))
+    }
+
+    /// The entry of the exit tilt and the harmonics nearest distance `r_mm` (L = `unit`).
+    fn exit_entry(r_mm: f64, unit: f64) -> usize {
+        ((r_mm / (r_mm + unit) * EXIT_TILT_ENTRIES as f64) as usize).min(EXIT_TILT_ENTRIES - 1)
     }
 
     pub fn texels(&self) -> Vec<[u32; 4]> {
@@ -452,9 +475,9 @@ impl CurvatureRatios {
             .chain(side(&self.concave_exit, mc_profile::EXIT_BINS))
             .chain(side(&self.convex_exit_far, mc_profile::EXIT_BINS))
             .chain(side(&self.concave_exit_far, mc_profile::EXIT_BINS))
-            .chain(self.exit_tilt.iter().map(|[c, g]| {
-                let pair = |a: f32, b: f32| half_bits(a) as u32 | (half_bits(b) as u32) << 16;
-                [pair(c[0], c[1]), pair(c[2], g[0]), pair(g[1], g[2]), 0]
+            .chain(self.exit_tilt.iter().chain(&self.harmonics).map(|[a, b]| {
+                let pair = |x: f32, y: f32| half_bits(x) as u32 | (half_bits(y) as u32) << 16;
+                [pair(a[0], a[1]), pair(a[2], b[0]), pair(b[1], b[2]), 0]
             }))
             .collect()
     }
@@ -510,7 +533,7 @@ impl CurvatureRatios {
 
     /// Texels after the light across.
     pub const TEXELS: usize =
-        1 + Self::ROWS * (CURVATURE_TABLE_ENTRIES + 2 * mc_profile::EXIT_BINS) + EXIT_TILT_ENTRIES;
+        1 + Self::ROWS * (CURVATURE_TABLE_ENTRIES + 2 * mc_profile::EXIT_BINS) + 2 * EXIT_TILT_ENTRIES;
 }
 
 /// Beam diffusion's entry at `r` of a table of `reach`: Sd, but at r = 0 the v0 for which the
