@@ -189,10 +189,12 @@ fn the_azimuthal_harmonic_packs_and_leans_ahead() {
 /// same chord, as before, the smaller node's steep rise toward its antipode leaked into the middle
 /// chords and the larger node's middle into the antipode: red 1.04-1.17 of the walk at 2-6.5 mm,
 /// 0.66-0.88 in the last 2 mm. Measured now (the walk's noise 0.7-1.4% in red, 1-6% in green):
-/// red and green 0.97-1.03 out to 1.1R; beyond, red 0.98-1.09 and green 0.85-1.00,
-/// which is the rows' own noise (a node's walk counts 100-300 photons per entry there: at R =
-/// 7.34 mm, on node 0.5, green is 0.86-1.08; with four times the photons 0.94-1.05 in red and
-/// 0.89-0.98 in green here, at six times the table's time).
+/// red and green 0.97-1.03 out to 1.1R; beyond, red 0.98-1.08 and green 0.94-1.05. Before the
+/// table's photons split as they go far (`halfspace::Split`), the far chords counted 100-300
+/// photons per entry or too few to measure, held a nearer entry's ratio where the ball's keeps
+/// rising, and green was 0.85-1.00 beyond 1.1R (with a walk of 2M photons, 0.89-0.99 unsplit,
+/// 0.93-1.04 split): the bound there, 10%, is one the unsplit table fails. (Blue, not held to
+/// it: its far rings, where the walk counts a handful, 0.60-0.86 unsplit and 0.65-0.97 split.)
 #[test]
 fn between_nodes_the_ratio_reads_each_ball_at_the_same_place() {
     let media = skin1();
@@ -229,11 +231,7 @@ fn between_nodes_the_ratio_reads_each_ball_at_the_same_place() {
             let ratio = drawn / (count as f64 / photons as f64);
             line += &format!(" {ratio:.3}");
             if count >= 400 {
-                let bound = match (k < 11, c) {
-                    (true, _) => 0.05,
-                    (false, 0) => 0.12,
-                    _ => 0.20,
-                };
+                let bound = if k < 11 { 0.05 } else { 0.10 };
                 measured.push((k, ratio, bound));
             }
         }

@@ -68,6 +68,14 @@ fn ketchup_thin_slab_against_the_path_tracer() {
 /// selection moves a back-lit mean by 4%). Each case is held to its measured ratio within 4%
 /// so that it fails if the model moves either way: a fix of a
 /// deficit updates the numbers here, with its cause.
+/// - **The curvature table's photons split as they go far** (2026-12-07, `halfspace::Split`,
+///   curvature_profile.rs): its far chords, where the walks counted too few and held a nearer
+///   entry's ratio, are measured. The Skin1 bunny 1.053 0.927 0.880 → 1.054 0.935 0.889, the
+///   back-lit Skin1 sphere 1.057 0.982 0.953 → 1.056 0.993 0.957, Marble's bunny 1.038 1.015
+///   0.969 → 1.037 1.012 0.967, Ketchup's back-lit sphere (recorded) 1.104 1.027 1.051 → 1.102
+///   1.036 1.051, the box 1.157 1.055 0.977 → 1.156 1.057 0.979, the back-lit torus 1.072 1.025
+///   0.993 → 1.072 1.027 0.995, the back-lit Marble and Potato spheres' blue 1.018 → 1.014 and
+///   1.052 → 1.049; the rest within 0.1%, every slab and every single scattering unchanged.
 /// - **The lean's second and third harmonics** (2026-12-07, `McProfile::harmonics`): an oblique
 ///   beam's light is peaked ahead of it and flat behind it, where the first harmonic alone left
 ///   0.68–0.90 of the walk's behind and 1.09–1.30 to the sides (tests/curvature_profile.rs).
@@ -156,17 +164,17 @@ fn ketchup_thin_slab_against_the_path_tracer() {
 fn curved_objects_against_the_path_tracer() {
     let brute = ["--brute-force", "--samples", "100000"];
     let cases: [(&str, &[&str], [f64; 3]); 11] = [
-        ("skin1/sphere-front", &brute, [1.002, 0.998, 0.997]),
-        ("skin1/sphere-back", &brute, [1.057, 0.982, 0.953]),
-        ("skin1/box-back", &brute, [1.157, 1.055, 0.977]),
+        ("skin1/sphere-front", &brute, [1.002, 0.998, 0.998]),
+        ("skin1/sphere-back", &brute, [1.056, 0.993, 0.957]),
+        ("skin1/box-back", &brute, [1.156, 1.057, 0.979]),
         ("skin1/torus-front", &brute, [1.004, 1.000, 1.008]),
-        ("skin1/torus-back", &brute, [1.072, 1.025, 0.993]),
-        ("skin1/bunny", &[], [1.053, 0.927, 0.880]),
-        ("marble/bunny", &[], [1.038, 1.015, 0.969]),
+        ("skin1/torus-back", &brute, [1.072, 1.027, 0.995]),
+        ("skin1/bunny", &[], [1.054, 0.935, 0.889]),
+        ("marble/bunny", &[], [1.037, 1.012, 0.967]),
         ("potato/sphere-front", &[], [1.014, 1.018, 1.001]),
-        ("marble/sphere-front", &[], [1.011, 1.007, 1.004]),
-        ("potato/sphere-back", &[], [1.037, 1.050, 1.052]),
-        ("marble/sphere-back", &[], [1.006, 1.024, 1.018]),
+        ("marble/sphere-front", &[], [1.011, 1.007, 1.003]),
+        ("potato/sphere-back", &[], [1.037, 1.050, 1.049]),
+        ("marble/sphere-back", &[], [1.006, 1.023, 1.014]),
     ];
     for (name, sampling, expected) in cases {
         for (ch, ratio) in mc_against_its_reference(name, sampling).into_iter().enumerate() {

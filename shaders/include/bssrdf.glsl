@@ -219,16 +219,15 @@ vec3 curvature_exit(usamplerBuffer table, vec4 rows, float cos_o, float far) {
     return mix(mix(at[0], at[1], y - j), mix(at[2], at[3], y - j), far);
 }
 
-// The Monte Carlo table's exit tilt [c, g] per channel at distance r (mirrors
-// gpu::sd_table::CurvatureRatios::exit_tilt_at, physics::mc_profile::McProfile::exit_tilt_at):
-// after the curvature rows and the exit rows, EXIT_TILT_ENTRIES texels of f16 pairs (c_r, c_g),
-// (c_b, g_r), (g_g, g_b) at the centres of u = r/(r + L), the nearest read; `unit_mm` = L (0:
-// none, the other models).
+// The Monte Carlo table's terms per distance r after the curvature rows, at one entry for both
+// (the nearest of EXIT_TILT_ENTRIES at the centres of u = r/(r + L); `unit_mm` = L, 0: none, the
+// other models, and all four 0): the exit tilt [c, g] per channel (mirrors
+// gpu::sd_table::CurvatureRatios::exit_tilt_at, physics::mc_profile::McProfile::exit_tilt_at),
+// then, EXIT_TILT_ENTRIES texels on, the lean's higher azimuthal harmonics [b₂, b₃]
+// (CurvatureRatios::harmonics_at, McProfile::higher_harmonics); each texel f16 pairs (x_r, x_g),
+// (x_b, y_r), (y_g, y_b). `with_tilt` false: the tilt is not fetched (no exit direction) and is 0.
 const int EXIT_TILT_BASE =
     CURVATURE_BASE + 1 + 2 * int(CURVATURE_NODES * CURVATURE_TABLE_ENTRIES) + 4 * int(CURVATURE_NODES * MC_EXIT_BINS);
-int exit_entry(float unit_mm, float r_mm) {
-    return min(int(r_mm / (r_mm + unit_mm) * float(EXIT_TILT_ENTRIES)), int(EXIT_TILT_ENTRIES) - 1);
-}
 // Six f16 of texel `t` as two vec3: (a_r, a_g), (a_b, b_r), (b_g, b_b).
 void two_rgb_halves(usamplerBuffer table, int t, out vec3 a, out vec3 b) {
     uvec3 pairs = texelFetch(table, t).xyz;
@@ -236,20 +235,13 @@ void two_rgb_halves(usamplerBuffer table, int t, out vec3 a, out vec3 b) {
     a = vec3(p.x, p.y, q.x);
     b = vec3(q.y, w.x, w.y);
 }
-void exit_tilt(usamplerBuffer table, float unit_mm, float r_mm, out vec3 c, out vec3 g) {
-    c = g = vec3(0.0);
+void exit_terms(usamplerBuffer table, float unit_mm, float r_mm, bool with_tilt, out vec3 c, out vec3 g, out vec3 b2,
+                out vec3 b3) {
+    c = g = b2 = b3 = vec3(0.0);
     if (!(unit_mm > 0.0)) return;
-    two_rgb_halves(table, EXIT_TILT_BASE + exit_entry(unit_mm, r_mm), c, g);
-}
-
-// The Monte Carlo table's higher azimuthal harmonics b₂, b₃ per channel at distance r (mirrors
-// gpu::sd_table::CurvatureRatios::harmonics_at, physics::mc_profile::McProfile::higher_harmonics):
-// EXIT_TILT_ENTRIES texels after the exit tilt, the same entries, f16 pairs (b₂_r, b₂_g),
-// (b₂_b, b₃_r), (b₃_g, b₃_b); 0 without the table (`unit_mm` 0).
-void azimuth_harmonics(usamplerBuffer table, float unit_mm, float r_mm, out vec3 b2, out vec3 b3) {
-    b2 = b3 = vec3(0.0);
-    if (!(unit_mm > 0.0)) return;
-    two_rgb_halves(table, EXIT_TILT_BASE + int(EXIT_TILT_ENTRIES) + exit_entry(unit_mm, r_mm), b2, b3);
+    int t = EXIT_TILT_BASE + min(int(r_mm / (r_mm + unit_mm) * float(EXIT_TILT_ENTRIES)), int(EXIT_TILT_ENTRIES) - 1);
+    if (with_tilt) two_rgb_halves(table, t, c, g);
+    two_rgb_halves(table, t + int(EXIT_TILT_ENTRIES), b2, b3);
 }
 
 // The ray-source term S'(x, w, r) of the directional dipole.

@@ -87,13 +87,12 @@ vec3 mc_sd(vec3 d, vec3 ni, float kappa, vec3 toward[3]) {
                                dot(toward[1], toward[1]) - dot(toward[1], ni) * dot(toward[1], ni),
                                dot(toward[2], toward[2]) - dot(toward[2], ni) * dot(toward[2], ni)) / (eta * eta)
                         : vec3(0.0);
-    vec3 b, b2, b3;
+    vec3 b, b2, b3, c, g;
     vec3 sd = sd_table_azimuth(dipole_table, dipole_header, r, b);
-    azimuth_harmonics(dipole_table, pixel_curvature_rows.w, r, b2, b3);
+    bool tilted = exit_along != vec3(0.0);
+    exit_terms(dipole_table, pixel_curvature_rows.w, r, tilted, c, g, b2, b3);
     vec3 tilt = vec3(1.0);
-    if (exit_along != vec3(0.0)) {
-        vec3 c, g;
-        exit_tilt(dipole_table, pixel_curvature_rows.w, r, c, g);
+    if (tilted) {
         vec3 away = d - dot(d, exit_normal) * exit_normal;
         float away_len = length(away);
         float radial = away_len > 0.0 ? dot(exit_along, away) / away_len : 0.0;

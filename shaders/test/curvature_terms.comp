@@ -1,7 +1,7 @@
 #version 460
 // For tests/bssrdf_gpu.rs only: the Monte Carlo table's curvature terms as the shade pass reads
-// them (bssrdf.glsl: `curvature_ratio`, `curvature_exit`, `exit_tilt`), against their Rust
-// mirrors (gpu::sd_table::CurvatureRatios::lookup, lookup_exit, exit_tilt_at).
+// them (bssrdf.glsl: `curvature_ratio`, `curvature_exit`, `exit_terms`), against their Rust
+// mirrors (gpu::sd_table::CurvatureRatios::lookup, lookup_exit, exit_tilt_at, harmonics_at).
 #include "gpu_constants.glsl"
 #include "bssrdf.glsl"
 
@@ -22,8 +22,7 @@ void main() {
     vec4 q = queries[i];
     vec4 rows = curvature_rows(table, q.y);
     vec3 c, g, b2, b3;
-    exit_tilt(table, rows.w, q.x, c, g);
-    azimuth_harmonics(table, rows.w, q.x, b2, b3);
+    exit_terms(table, rows.w, q.x, true, c, g, b2, b3);
     results[6u * i] = vec4(curvature_ratio(table, rows, q.x), 0.0);
     results[6u * i + 1u] = vec4(curvature_exit(table, rows, q.z, q.w), 0.0);
     results[6u * i + 2u] = vec4(c, 0.0);

@@ -303,7 +303,7 @@ const _: () = assert!(curvature_profile::FIRST_CURVATURE_LOG2 + 8 == super::CURV
 /// Entries per row of [`CurvatureRatios`] (bssrdf.glsl reads the nearest: fine enough that
 /// rounding r moves a ratio by under 1%; tests/curvature_profile.rs).
 pub const CURVATURE_TABLE_ENTRIES: usize = super::CURVATURE_TABLE_ENTRIES as usize;
-/// Entries of [`CurvatureRatios`]'s exit tilt (bssrdf.glsl's `exit_tilt`).
+/// Entries of [`CurvatureRatios`]'s exit tilt (bssrdf.glsl's `exit_terms`).
 pub const EXIT_TILT_ENTRIES: usize = super::EXIT_TILT_ENTRIES as usize;
 
 /// The Monte Carlo table's curvature ratios, after the light across in the same buffer
@@ -319,9 +319,9 @@ pub const EXIT_TILT_ENTRIES: usize = super::EXIT_TILT_ENTRIES as usize;
 /// of the light from within a chord R√2, then 2N more of the light from beyond it. Then the
 /// Monte Carlo table's exit tilt [c, g] ([`McProfile::exit_tilt_at`]) at EXIT_TILT_ENTRIES
 /// centres of u = r/(r + L), one texel each: f16 pairs (c_r, c_g), (c_b, g_r), (g_g, g_b)
-/// (`exit_tilt`; it rides here, where L is read per pixel anyway, as the Sd table's texels have
+/// (`exit_terms`; it rides here, where L is read per pixel anyway, as the Sd table's texels have
 /// no word left). Then the higher azimuthal harmonics [b₂, b₃] ([`McProfile::higher_harmonics`])
-/// at the same centres, f16 pairs (b₂_r, b₂_g), (b₂_b, b₃_r), (b₃_g, b₃_b) (`azimuth_harmonics`).
+/// at the same centres, f16 pairs (b₂_r, b₂_g), (b₂_b, b₃_r), (b₃_g, b₃_b) (`exit_terms`, at the same entry).
 #[derive(Clone, Debug, PartialEq)]
 pub struct CurvatureRatios {
     pub unit_mm: f32,
@@ -426,7 +426,7 @@ impl CurvatureRatios {
     }
 
     /// The exit tilt [c, g] per channel at distance `r_mm`, as the shade pass reads it
-    /// (`exit_tilt`): the nearest entry, in f16; 0 without ratios.
+    /// (`exit_terms`'s c, g): the nearest entry, in f16; 0 without ratios.
     pub fn exit_tilt_at(&self, r_mm: f64) -> [[f64; 3]; 2] {
         let unit = self.unit_mm as f64;
         if unit.is_nan() || unit <= 0.0 {
@@ -436,7 +436,7 @@ impl CurvatureRatios {
     }
 
     /// The higher azimuthal harmonics [b₂, b₃] per channel at distance `r_mm`, as the shade pass
-    /// reads them (`azimuth_harmonics`): the nearest entry, in f16; 0 without ratios.
+    /// reads them (`exit_terms`'s b₂, b₃, at the tilt's entry): the nearest entry, in f16; 0 without ratios.
     pub fn harmonics_at(&self, r_mm: f64) -> [[f64; 3]; 2] {
         let unit = self.unit_mm as f64;
         if unit.is_nan() || unit <= 0.0 {

@@ -12,7 +12,7 @@ use super::{fresnel, halfspace};
 use glam::DVec3;
 use std::f64::consts::PI;
 
-use halfspace::SplitMix as Rng;
+use halfspace::{Photon, Split, SplitMix as Rng};
 
 /// Where a photon left the sphere: its exit point relative to the pole (mean free paths), its
 /// direction outside (refracted), cos²θo outside to the local normal, the geodesic distance
@@ -24,6 +24,8 @@ pub struct SphereEscape {
     pub mu_o2: f64,
     pub geodesic: f64,
     pub scatterings: u32,
+    /// The photon's weight: 1, less after it split ([`Split`]).
+    pub weight: f64,
 }
 
 /// Distance along `d` from `p` (in the medium) to the sphere |p − c| = |R|, c = (0, 0, −R).
@@ -42,51 +44,59 @@ fn distance_out(radius: f64, p: DVec3, d: DVec3) -> f64 {
     t.max(0.0)
 }
 
-/// One photon's walk inside a sphere of radius `radius` from `p` (on or inside the surface)
-/// going `d` (unit, into the medium): exponential free paths, absorption with probability
-/// 1 − `albedo` at each collision (and after `max_collisions`), isotropic scattering, and at the
-/// surface Fresnel reflection or escape with refraction, which `on_escape` is told. Returns the
+/// One photon's walk inside a sphere of radius `radius` from where `photon` is (on or inside the
+/// surface; its direction unit, into the medium): exponential free paths, absorption with
+/// probability 1 − `albedo` at each collision (and after `max_collisions`), isotropic
+/// scattering, and at the surface Fresnel reflection or escape with refraction, which
+/// `on_escape` is told; where it splits (`split`), its copies' walks too. Returns the
 /// scatterings.
 fn walk(
     rng: &mut Rng,
     (albedo, eta, radius): (f64, f64, f64),
-    mut p: DVec3,
-    mut d: DVec3,
+    mut photon: Photon,
     max_collisions: u32,
-    on_escape: &mut impl FnMut(&SphereEscape),
-) -> u32 {
+    split: Option<&Split>,
+    on_escape: &mut dyn FnMut(&SphereEscape),
+) -> u64 {
     let centre = DVec3::new(0.0, 0.0, -radius);
-    let mut scatterings = 0u32;
+    let mut collisions = 0u64;
+    // A copy split off at a collision starts there, before its own absorption and scattering.
+    let mut fly = !std::mem::take(&mut photon.colliding);
     loop {
-        let s = -rng.next().ln();
-        let t = distance_out(radius, p, d);
-        if s >= t {
-            p += t * d;
-            // Outward from the medium: away from a ball's centre, toward a cavity's.
-            let n = ((p - centre) * radius.signum()).normalize();
-            let cos = d.dot(n).clamp(0.0, 1.0);
-            if rng.next() < fresnel::reflectance(1.0 / eta, cos) {
-                d = (d - 2.0 * d.dot(n) * n).normalize();
-                continue;
+        if std::mem::replace(&mut fly, true) {
+            let s = -rng.next().ln();
+            let (p, d) = (&mut photon.p, &mut photon.d);
+            let t = distance_out(radius, *p, *d);
+            if s >= t {
+                *p += t * *d;
+                // Outward from the medium: away from a ball's centre, toward a cavity's.
+                let n = ((*p - centre) * radius.signum()).normalize();
+                let cos = d.dot(n).clamp(0.0, 1.0);
+                if rng.next() < fresnel::reflectance(1.0 / eta, cos) {
+                    *d = (*d - 2.0 * d.dot(n) * n).normalize();
+                    continue;
+                }
+                let mu_o2 = (1.0 - eta * eta * (1.0 - cos * cos)).clamp(0.0, 1.0);
+                // Snell from index η to 1: the tangential part scales by η.
+                let direction = (eta * (*d - cos * n) + mu_o2.sqrt() * n).normalize();
+                // |R| times the angle at the centre between the pole and the exit.
+                let (q, pole) = (*p - centre, -centre);
+                let geodesic = radius.abs() * q.cross(pole).length().atan2(q.dot(pole));
+                let (position, scatterings, weight) = (*p, photon.scatterings, photon.weight);
+                on_escape(&SphereEscape { position, direction, mu_o2, geodesic, scatterings, weight });
+                return collisions;
             }
-            let mu_o2 = (1.0 - eta * eta * (1.0 - cos * cos)).clamp(0.0, 1.0);
-            // Snell from index η to 1: the tangential part scales by η.
-            let direction = (eta * (d - cos * n) + mu_o2.sqrt() * n).normalize();
-            // |R| times the angle at the centre between the pole and the exit.
-            let (q, pole) = (p - centre, -centre);
-            let geodesic = radius.abs() * q.cross(pole).length().atan2(q.dot(pole));
-            on_escape(&SphereEscape { position: p, direction, mu_o2, geodesic, scatterings });
-            return scatterings;
+            *p += s * *d;
+            if let Some(split) = split {
+                collisions += split.at(rng, &mut photon, &mut |rng, copy| {
+                    walk(rng, (albedo, eta, radius), copy, max_collisions, Some(split), on_escape)
+                });
+            }
         }
-        p += s * d;
-        if rng.next() >= albedo || scatterings >= max_collisions {
-            return scatterings;
+        if !photon.collide(rng, albedo, max_collisions) {
+            return collisions;
         }
-        scatterings += 1;
-        let mu = 2.0 * rng.next() - 1.0;
-        let phi = 2.0 * PI * rng.next();
-        let st = (1.0 - mu * mu).max(0.0).sqrt();
-        d = DVec3::new(st * phi.cos(), st * phi.sin(), mu);
+        collisions += 1;
     }
 }
 
@@ -101,12 +111,28 @@ pub fn trace_sphere(
     radius: f64,
     start: DVec3,
     photons: u64,
+    seeds: (u64, u32),
+    on_escape: impl FnMut(&SphereEscape),
+) -> u64 {
+    trace_sphere_split(albedo, eta, radius, start, photons, seeds, None, on_escape)
+}
+
+/// [`trace_sphere`] whose photons split as they go far from the pole ([`Split`]; None: the
+/// analogue walk, bit for bit).
+#[allow(clippy::too_many_arguments)]
+pub fn trace_sphere_split(
+    albedo: f64,
+    eta: f64,
+    radius: f64,
+    start: DVec3,
+    photons: u64,
     (seed, max_collisions): (u64, u32),
+    split: Option<&Split>,
     mut on_escape: impl FnMut(&SphereEscape),
 ) -> u64 {
     let mut rng = Rng(seed);
     (0..photons)
-        .map(|_| walk(&mut rng, (albedo, eta, radius), DVec3::ZERO, start, max_collisions, &mut on_escape) as u64)
+        .map(|_| walk(&mut rng, (albedo, eta, radius), Photon::entering(start), max_collisions, split, &mut on_escape))
         .sum()
 }
 
@@ -119,7 +145,8 @@ pub fn trace_from(
     (seed, max_collisions): (u64, u32),
     mut on_escape: impl FnMut(&SphereEscape),
 ) -> u32 {
-    walk(&mut Rng(seed), (albedo, eta, radius), p, d, max_collisions, &mut on_escape)
+    let photon = Photon { p, ..Photon::entering(d) };
+    walk(&mut Rng(seed), (albedo, eta, radius), photon, max_collisions, None, &mut on_escape) as u32
 }
 
 /// Rings of geodesic distance from the entry point (mean free paths): edge 0 is 0, then
@@ -342,7 +369,14 @@ pub fn beam_view(
     };
     for _ in 0..photons {
         if let Some((p, d)) = launch(&mut rng, eta, radius, beam) {
-            walk(&mut rng, (albedo, eta, radius), p, d, max_collisions, &mut on_escape);
+            walk(
+                &mut rng,
+                (albedo, eta, radius),
+                Photon { p, ..Photon::entering(d) },
+                max_collisions,
+                None,
+                &mut on_escape,
+            );
         }
     }
     // Each photon carries the power through the hole, πa² per unit irradiance, over `photons`.
