@@ -58,7 +58,7 @@ fn rings_toward(m: &Medium, r_mm: f64, toward: f64, grid: (u64, u64)) -> Vec<f64
     let radius = r_mm * (m.sigma_a + m.sigma_s * (1.0 - m.g));
     let cone = 12f64.to_radians();
     let mut power = vec![0.0; RINGS.len() - 1];
-    let photons = front_lit_walk(m, r_mm, grid, |ft, e| {
+    let photons = front_lit_walk(m, r_mm, grid, false, |ft, e| {
         // The eye's half of the ball only (the other projects onto the same rings).
         if e.scatterings < 2 || (e.position.z < -radius) != (toward < 0.0) || e.direction.z * toward < cone.cos() {
             return;

@@ -137,16 +137,19 @@ pub fn trace_sphere_split(
 }
 
 /// One photon's walk from `p` on the sphere going `d` into it (a beam entering anywhere, not
-/// only at the pole), seeded `seed`; returns its scatterings.
+/// only at the pole), seeded `seed`, splitting by its distance from the pole where `split` says
+/// (a light's far side, measured: `tests/common` `front_lit_walk`); returns the scatterings of
+/// it and its copies.
 pub fn trace_from(
     (albedo, eta, radius): (f64, f64, f64),
     p: DVec3,
     d: DVec3,
     (seed, max_collisions): (u64, u32),
+    split: Option<&Split>,
     mut on_escape: impl FnMut(&SphereEscape),
-) -> u32 {
+) -> u64 {
     let photon = Photon { p, ..Photon::entering(d) };
-    walk(&mut Rng(seed), (albedo, eta, radius), photon, max_collisions, None, &mut on_escape) as u32
+    walk(&mut Rng(seed), (albedo, eta, radius), photon, max_collisions, split, &mut on_escape)
 }
 
 /// Rings of geodesic distance from the entry point (mean free paths): edge 0 is 0, then

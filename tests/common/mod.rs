@@ -197,18 +197,32 @@ pub fn box_obj(half: f32, thickness: f32, uv: bool) -> String {
 /// Light along −z on a sphere of radius `r_mm` (centre (0, 0, −R) in mean free paths, the pole at
 /// the origin), walked exactly: photons on a stratified grid of `discs` × `angles` over the
 /// sphere's disc (equal areas: ring k's radius ∝ √((k + ½)/discs)), each entering refracted and
-/// weighted by its Fresnel transmittance; `on_escape(weight, escape)` for each escape. Returns the
-/// photons traced (each stands for πR²/photons of the disc).
+/// weighted by its Fresnel transmittance; `on_escape(weight, escape)` for each escape. With
+/// `dark_side`, past the equator a photon splits in two each ln 2 diffusion lengths further from
+/// the pole (up to 1024 copies of as much less weight, `halfspace::Split`), so that the dark
+/// half, where an analogue walk counts a handful of photons per ring in a channel that diffuses
+/// short, is measured nearly as well as the lit one (Skin1's blue at 145°: noise 28% → 6%), at
+/// 2–15× the time; the weight passed is Ft times the escape's. Returns the photons traced (each
+/// stands for πR²/photons of the disc).
 pub fn front_lit_walk(
     m: &translucent::physics::Medium,
     r_mm: f64,
     (discs, angles): (u64, u64),
+    dark_side: bool,
     mut on_escape: impl FnMut(f64, &translucent::physics::sphere::SphereEscape),
 ) -> u64 {
     let sigma_t = m.sigma_a + m.sigma_s * (1.0 - m.g);
     let (albedo, radius) = (m.sigma_s * (1.0 - m.g) / sigma_t, r_mm * sigma_t);
     let centre = glam::DVec3::new(0.0, 0.0, -radius);
     let photons = discs * angles;
+    // Geodesic distance from the pole past the equator, in halvings of the diffusion profile
+    // (1/σtr = 1/√(3(1 − α')) mean free paths).
+    let halving = std::f64::consts::LN_2 / (3.0 * (1.0 - albedo)).sqrt();
+    let level = move |chord: f64| {
+        let geodesic = 2.0 * radius * (chord / (2.0 * radius)).min(1.0).asin();
+        ((geodesic - 0.5 * std::f64::consts::PI * radius).max(0.0) / halving).min(10.0) as u32
+    };
+    let split = translucent::physics::halfspace::Split { level: &level, allowance: std::cell::Cell::new(u64::MAX) };
     for i in 0..photons {
         let (k, j) = (i / angles, i % angles);
         let rho = radius * ((k as f64 + 0.5) / discs as f64).sqrt();
@@ -221,7 +235,14 @@ pub fn front_lit_walk(
         let cos_t = (1.0 - (1.0 - cos_i * cos_i) / (m.eta * m.eta)).max(0.0).sqrt();
         let t = ((glam::DVec3::new(0.0, 0.0, -1.0) + cos_i * n) / m.eta - cos_t * n).normalize();
         let seed = 0x1234_5678 ^ i.wrapping_mul(0x9E37_79B9_7F4A_7C15);
-        translucent::physics::sphere::trace_from((albedo, m.eta, radius), p, t, (seed, 100_000), |e| on_escape(ft, e));
+        translucent::physics::sphere::trace_from(
+            (albedo, m.eta, radius),
+            p,
+            t,
+            (seed, 100_000),
+            dark_side.then_some(&split),
+            |e| on_escape(ft * e.weight, e),
+        );
     }
     photons
 }
