@@ -145,11 +145,11 @@ fn gpu_table_models_match_cpu() {
 }
 
 /// The Monte Carlo table's curvature terms as the shade pass reads them (bssrdf.glsl
-/// `curvature_rows` + `curvature_ratio`, `curvature_exit`, `exit_tilt`, `azimuth_harmonics`; f16
-/// texels, f32 arithmetic) against their Rust mirrors (`CurvatureRatios::lookup`, `lookup_exit`,
-/// `exit_tilt_at`, `harmonics_at`; the same f16 values in f64), for Skin1: random chords out to 30 L, curvatures
+/// `curvature_rows` + `curvature_ratio`, `curvature_exit`, `exit_terms`; f16 texels, f32
+/// arithmetic) against their Rust mirrors (`CurvatureRatios::lookup`, `lookup_exit`,
+/// `exit_tilt_at`, `harmonics_at`, `radial_at`; the same f16 values in f64), for Skin1: random chords out to 30 L, curvatures
 /// of both signs from L/64 to 16 L (past the last node too) and flat, exit cosines and far
-/// shares. Within 1e-5 relative (the tilt and the harmonics, which cross 0, 1e-5 absolute and relative; measured
+/// shares. Within 1e-5 relative (the tilt, the harmonics and the radial change, which cross 0, 1e-5 absolute and relative; measured
 /// 8e-7 for the ratio, 2e-7 for the exit's, the tilt exact), except where the nearest entry's
 /// index lies within 1e-4 of a boundary (f32 and f64 may round apart). It found the Rust mirror
 /// of f16 dropping the sign (the tilt's g is negative near the entry).
@@ -195,7 +195,7 @@ fn gpu_curvature_terms_match_cpu() {
         .collect();
 
     let (ctx, counts) = validated_context();
-    const TERMS: usize = 6;
+    const TERMS: usize = 7;
     let results: Vec<[f32; 4]> = {
         let pipeline = Pipeline::compute(&ctx, "test/curvature_terms.comp").unwrap();
         let table = vk::upload_buffer(&ctx, "table", &texels, BufferUsageFlags::UNIFORM_TEXEL_BUFFER).unwrap();
@@ -224,7 +224,7 @@ fn gpu_curvature_terms_match_cpu() {
         }
         let [c, g] = ratios.exit_tilt_at(r);
         let [b2, b3] = ratios.harmonics_at(r);
-        let cpu = [ratios.lookup(r, kappa), ratios.lookup_exit(cos_o, kappa, far), c, g, b2, b3];
+        let cpu = [ratios.lookup(r, kappa), ratios.lookup_exit(cos_o, kappa, far), c, g, b2, b3, ratios.radial_at(r)];
         for (k, expected) in cpu.iter().enumerate() {
             for ch in 0..3 {
                 let gpu = results[TERMS * i + k][ch] as f64;
@@ -242,8 +242,8 @@ fn gpu_curvature_terms_match_cpu() {
         checked += 1;
     }
     println!(
-        "{checked} queries; worst ratio {:.1e}, exit {:.1e}, c {:.1e}, g {:.1e}, b₂ {:.1e}, b₃ {:.1e}",
-        worst[0], worst[1], worst[2], worst[3], worst[4], worst[5]
+        "{checked} queries; worst ratio {:.1e}, exit {:.1e}, c {:.1e}, g {:.1e}, b₂ {:.1e}, b₃ {:.1e}, a {:.1e}",
+        worst[0], worst[1], worst[2], worst[3], worst[4], worst[5], worst[6]
     );
     assert!(checked > n * 9 / 10, "only {checked} of {n} queries checked");
 }

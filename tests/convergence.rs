@@ -148,6 +148,13 @@ fn default_images_converge_on_a_sphere() {
         // without it). So blue's gain is held where the near field acts, on brute force over
         // the default points (0.43, was 0.42); the tree's images to the 1% and no worse than
         // without the near field.
+        // With the radial change with incidence (2026-12-07, McProfile::radial) 0.77 / 0.82 /
+        // 0.75% against 0.77 / 0.89 / 1.14%, and on brute force 0.25 / 0.37 / 0.51% against
+        // 0.26 / 0.48 / 1.00%: an oblique beam's light is lower within half a mean free path of
+        // its entry (a = −0.12 … −0.44 there: 15–22% less at grazing incidence, sin²θt ≈ 0.5) and
+        // higher beyond, so the peak the plain sum
+        // samples badly is smaller and its error fell (1.23 → 1.00% in blue), while the near
+        // field's stayed (0.53 → 0.51%). Blue's gain is held at 0.55 (measured 0.51).
         // (0.77 / 0.58 / 0.37% before the tilt.)
         // (0.61 / 0.37 / 0.34% before each node was read at the same place on its ball; the
         // sigma points then kept the node's normal, 0.65 / 0.81 / 0.49%: see sources.glsl
@@ -161,7 +168,7 @@ fn default_images_converge_on_a_sphere() {
         let errors = case("sphere", model, &reference);
         check(&format!("sphere, {model:?}"), errors, bound, gain);
         if model == Model::Mc {
-            const BLUE_GAIN: f64 = 0.5;
+            const BLUE_GAIN: f64 = 0.55;
             let exact = |near_field| render_hdr(&settings("sphere", model, None, true, near_field));
             let with = channel_rmse(&exact(NearField::On), &reference);
             let without = channel_rmse(&exact(NearField::Off), &reference);

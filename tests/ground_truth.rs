@@ -68,6 +68,18 @@ fn ketchup_thin_slab_against_the_path_tracer() {
 /// selection moves a back-lit mean by 4%). Each case is held to its measured ratio within 4%
 /// so that it fails if the model moves either way: a fix of a
 /// deficit updates the numbers here, with its cause.
+/// - **The radial profile's change with incidence** (2026-12-07, `McProfile::radial`): an oblique
+///   beam's light spreads further than the normal beam's times f(θt), which the flat
+///   half-space's walk measures (1.25–3.1 mm from a Skin1 beam at cos θi 0.2 the model was 0.88
+///   of it in blue, now 0.98). The Skin1 bunny 1.054 0.935 0.889 → 1.056 0.955 0.913, the
+///   back-lit Skin1 sphere 1.056 0.993 0.957 → 1.059 1.024 0.992, Marble's 1.006 1.023 1.014 →
+///   0.998 1.009 0.999; but what is too bright far from an oblique entry on a ball (README,
+///   "The same rings against a walk that splits") now shows more: the box 1.156 1.057 0.979 →
+///   1.165 1.086 1.014, the back-lit torus 1.072 1.027 0.995 → 1.077 1.044 1.014, Potato's
+///   back-lit sphere 1.037 1.050 1.049 → 1.046 1.056 1.078, Ketchup's (recorded) 1.102 1.036
+///   1.051 → 1.126 1.041 1.059; Marble's bunny 1.037 1.012 0.967 → 1.030 1.003 0.959; the
+///   front-lit spheres within 1% (Potato's red and green 1.014 1.018 → 1.023 1.023); the slabs,
+///   single scattering and the far point light unchanged.
 /// - **The curvature table's photons split as they go far** (2026-12-07, `halfspace::Split`,
 ///   curvature_profile.rs): its far chords, where the walks counted too few and held a nearer
 ///   entry's ratio, are measured. The Skin1 bunny 1.053 0.927 0.880 → 1.054 0.935 0.889, the
@@ -164,17 +176,17 @@ fn ketchup_thin_slab_against_the_path_tracer() {
 fn curved_objects_against_the_path_tracer() {
     let brute = ["--brute-force", "--samples", "100000"];
     let cases: [(&str, &[&str], [f64; 3]); 11] = [
-        ("skin1/sphere-front", &brute, [1.002, 0.998, 0.998]),
-        ("skin1/sphere-back", &brute, [1.056, 0.993, 0.957]),
-        ("skin1/box-back", &brute, [1.156, 1.057, 0.979]),
-        ("skin1/torus-front", &brute, [1.004, 1.000, 1.008]),
-        ("skin1/torus-back", &brute, [1.072, 1.027, 0.995]),
-        ("skin1/bunny", &[], [1.054, 0.935, 0.889]),
-        ("marble/bunny", &[], [1.037, 1.012, 0.967]),
-        ("potato/sphere-front", &[], [1.014, 1.018, 1.001]),
-        ("marble/sphere-front", &[], [1.011, 1.007, 1.003]),
-        ("potato/sphere-back", &[], [1.037, 1.050, 1.049]),
-        ("marble/sphere-back", &[], [1.006, 1.023, 1.014]),
+        ("skin1/sphere-front", &brute, [1.004, 1.000, 0.999]),
+        ("skin1/sphere-back", &brute, [1.059, 1.024, 0.992]),
+        ("skin1/box-back", &brute, [1.165, 1.086, 1.014]),
+        ("skin1/torus-front", &brute, [1.005, 0.999, 1.007]),
+        ("skin1/torus-back", &brute, [1.077, 1.044, 1.014]),
+        ("skin1/bunny", &[], [1.056, 0.955, 0.913]),
+        ("marble/bunny", &[], [1.030, 1.003, 0.959]),
+        ("potato/sphere-front", &[], [1.023, 1.023, 1.002]),
+        ("marble/sphere-front", &[], [1.014, 1.008, 1.004]),
+        ("potato/sphere-back", &[], [1.046, 1.056, 1.078]),
+        ("marble/sphere-back", &[], [0.998, 1.009, 0.999]),
     ];
     for (name, sampling, expected) in cases {
         for (ch, ratio) in mc_against_its_reference(name, sampling).into_iter().enumerate() {

@@ -224,8 +224,10 @@ vec3 curvature_exit(usamplerBuffer table, vec4 rows, float cos_o, float far) {
 // other models, and all four 0): the exit tilt [c, g] per channel (mirrors
 // gpu::sd_table::CurvatureRatios::exit_tilt_at, physics::mc_profile::McProfile::exit_tilt_at),
 // then, EXIT_TILT_ENTRIES texels on, the lean's higher azimuthal harmonics [b₂, b₃]
-// (CurvatureRatios::harmonics_at, McProfile::higher_harmonics); each texel f16 pairs (x_r, x_g),
-// (x_b, y_r), (y_g, y_b). `with_tilt` false: the tilt is not fetched (no exit direction) and is 0.
+// (CurvatureRatios::harmonics_at, McProfile::higher_harmonics), then as many on the radial
+// profile's change with incidence [a, 0] (CurvatureRatios::radial_at, McProfile::radial_at);
+// each texel f16 pairs (x_r, x_g), (x_b, y_r), (y_g, y_b). `with_tilt` false: the tilt is not
+// fetched (no exit direction) and is 0.
 const int EXIT_TILT_BASE =
     CURVATURE_BASE + 1 + 2 * int(CURVATURE_NODES * CURVATURE_TABLE_ENTRIES) + 4 * int(CURVATURE_NODES * MC_EXIT_BINS);
 // Six f16 of texel `t` as two vec3: (a_r, a_g), (a_b, b_r), (b_g, b_b).
@@ -236,12 +238,14 @@ void two_rgb_halves(usamplerBuffer table, int t, out vec3 a, out vec3 b) {
     b = vec3(q.y, w.x, w.y);
 }
 void exit_terms(usamplerBuffer table, float unit_mm, float r_mm, bool with_tilt, out vec3 c, out vec3 g, out vec3 b2,
-                out vec3 b3) {
-    c = g = b2 = b3 = vec3(0.0);
+                out vec3 b3, out vec3 a) {
+    c = g = b2 = b3 = a = vec3(0.0);
     if (!(unit_mm > 0.0)) return;
     int t = EXIT_TILT_BASE + min(int(r_mm / (r_mm + unit_mm) * float(EXIT_TILT_ENTRIES)), int(EXIT_TILT_ENTRIES) - 1);
     if (with_tilt) two_rgb_halves(table, t, c, g);
     two_rgb_halves(table, t + int(EXIT_TILT_ENTRIES), b2, b3);
+    vec3 unused;
+    two_rgb_halves(table, t + 2 * int(EXIT_TILT_ENTRIES), a, unused);
 }
 
 // The ray-source term S'(x, w, r) of the directional dipole.

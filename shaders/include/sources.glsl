@@ -87,10 +87,10 @@ vec3 mc_sd(vec3 d, vec3 ni, float kappa, vec3 toward[3]) {
                                dot(toward[1], toward[1]) - dot(toward[1], ni) * dot(toward[1], ni),
                                dot(toward[2], toward[2]) - dot(toward[2], ni) * dot(toward[2], ni)) / (eta * eta)
                         : vec3(0.0);
-    vec3 b, b2, b3, c, g;
+    vec3 b, b2, b3, c, g, a;
     vec3 sd = sd_table_azimuth(dipole_table, dipole_header, r, b);
     bool tilted = exit_along != vec3(0.0);
-    exit_terms(dipole_table, pixel_curvature_rows.w, r, tilted, c, g, b2, b3);
+    exit_terms(dipole_table, pixel_curvature_rows.w, r, tilted, c, g, b2, b3, a);
     vec3 tilt = vec3(1.0);
     if (tilted) {
         vec3 away = d - dot(d, exit_normal) * exit_normal;
@@ -102,7 +102,9 @@ vec3 mc_sd(vec3 d, vec3 ni, float kappa, vec3 toward[3]) {
                                          dot(exit_along, toward[2] - dot(toward[2], ni) * ni));
         tilt = max(vec3(1.0) + c * radial + g * ahead, vec3(0.0));
     }
-    vec3 harmonics = vec3(1.0) + b * lean + b2 * (2.0 * lean * lean - m2) + b3 * (4.0 * lean * lean - 3.0 * m2) * lean;
+    // The radial change with incidence (1 + a sin²θt) times the harmonics (McProfile::lean).
+    vec3 harmonics = (vec3(1.0) + a * m2)
+                   * (vec3(1.0) + b * lean + b2 * (2.0 * lean * lean - m2) + b3 * (4.0 * lean * lean - 3.0 * m2) * lean);
     return sd * max(harmonics, vec3(0.0)) * tilt
         * curvature_ratio(dipole_table, curvature_rows_at(pixel_curvature_rows.w, kappa), r);
 }

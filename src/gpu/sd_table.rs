@@ -321,7 +321,9 @@ pub const EXIT_TILT_ENTRIES: usize = super::EXIT_TILT_ENTRIES as usize;
 /// centres of u = r/(r + L), one texel each: f16 pairs (c_r, c_g), (c_b, g_r), (g_g, g_b)
 /// (`exit_terms`; it rides here, where L is read per pixel anyway, as the Sd table's texels have
 /// no word left). Then the higher azimuthal harmonics [b₂, b₃] ([`McProfile::higher_harmonics`])
-/// at the same centres, f16 pairs (b₂_r, b₂_g), (b₂_b, b₃_r), (b₃_g, b₃_b) (`exit_terms`, at the same entry).
+/// at the same centres, f16 pairs (b₂_r, b₂_g), (b₂_b, b₃_r), (b₃_g, b₃_b) (`exit_terms`, at the same entry);
+/// then the radial profile's change with incidence a ([`McProfile::radial_at`]), f16 pairs
+/// (a_r, a_g), (a_b, 0), (0, 0).
 #[derive(Clone, Debug, PartialEq)]
 pub struct CurvatureRatios {
     pub unit_mm: f32,
@@ -337,6 +339,8 @@ pub struct CurvatureRatios {
     pub exit_tilt: Vec<[[f32; 3]; 2]>,
     /// Per entry, [b₂, b₃] per channel.
     pub harmonics: Vec<[[f32; 3]; 2]>,
+    /// Per entry, [a, 0] per channel.
+    pub radial: Vec<[[f32; 3]; 2]>,
 }
 
 impl CurvatureRatios {
@@ -356,6 +360,7 @@ impl CurvatureRatios {
             concave_exit_far: flat_exit,
             exit_tilt: vec![[[0.0; 3]; 2]; EXIT_TILT_ENTRIES],
             harmonics: vec![[[0.0; 3]; 2]; EXIT_TILT_ENTRIES],
+            radial: vec![[[0.0; 3]; 2]; EXIT_TILT_ENTRIES],
         }
     }
 
@@ -422,6 +427,7 @@ impl CurvatureRatios {
             concave_exit_far: exits(true, true),
             exit_tilt: per_exit_entry(&|c, r| profiles[c].exit_tilt_at(r)),
             harmonics: per_exit_entry(&|c, r| profiles[c].higher_harmonics(r)),
+            radial: per_exit_entry(&|c, r| [profiles[c].radial_at(r), 0.0]),
         }
     }
 
@@ -445,7 +451,17 @@ impl CurvatureRatios {
         self.harmonics[Self::exit_entry(r_mm, unit)].map(|v| v.map(|x| half_value(half_bits(x))))
     }
 
-    /// The entry of the exit tilt and the harmonics nearest distance `r_mm` (L = `unit`).
+    /// The radial change a per channel at distance `r_mm`, as the shade pass reads it
+    /// (`exit_terms`'s a, at the tilt's entry): the nearest entry, in f16; 0 without ratios.
+    pub fn radial_at(&self, r_mm: f64) -> [f64; 3] {
+        let unit = self.unit_mm as f64;
+        if unit.is_nan() || unit <= 0.0 {
+            return [0.0; 3];
+        }
+        self.radial[Self::exit_entry(r_mm, unit)][0].map(|x| half_value(half_bits(x)))
+    }
+
+    /// The entry of the exit tilt, the harmonics and the radial change nearest distance `r_mm` (L = `unit`).
     fn exit_entry(r_mm: f64, unit: f64) -> usize {
         ((r_mm / (r_mm + unit) * EXIT_TILT_ENTRIES as f64) as usize).min(EXIT_TILT_ENTRIES - 1)
     }
@@ -475,7 +491,7 @@ impl CurvatureRatios {
             .chain(side(&self.concave_exit, mc_profile::EXIT_BINS))
             .chain(side(&self.convex_exit_far, mc_profile::EXIT_BINS))
             .chain(side(&self.concave_exit_far, mc_profile::EXIT_BINS))
-            .chain(self.exit_tilt.iter().chain(&self.harmonics).map(|[a, b]| {
+            .chain(self.exit_tilt.iter().chain(&self.harmonics).chain(&self.radial).map(|[a, b]| {
                 let pair = |x: f32, y: f32| half_bits(x) as u32 | (half_bits(y) as u32) << 16;
                 [pair(a[0], a[1]), pair(a[2], b[0]), pair(b[1], b[2]), 0]
             }))
@@ -533,7 +549,7 @@ impl CurvatureRatios {
 
     /// Texels after the light across.
     pub const TEXELS: usize =
-        1 + Self::ROWS * (CURVATURE_TABLE_ENTRIES + 2 * mc_profile::EXIT_BINS) + 2 * EXIT_TILT_ENTRIES;
+        1 + Self::ROWS * (CURVATURE_TABLE_ENTRIES + 2 * mc_profile::EXIT_BINS) + 3 * EXIT_TILT_ENTRIES;
 }
 
 /// Beam diffusion's entry at `r` of a table of `reach`: Sd, but at r = 0 the v0 for which the
