@@ -162,7 +162,7 @@ fn wedge(material: &str, a_mm: f64, photons: u64) {
                 h / sigma_t,
                 chord / sigma_t,
                 exitance / plane_at(chord),
-                ratios[c].ratio(chord / sigma_t, kappa),
+                ratios[c].ratio(chord / sigma_t, kappa, 0.0),
                 kappa,
                 front[k]
             );

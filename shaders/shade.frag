@@ -864,7 +864,10 @@ void main() {
         // grazing light leaves a ball than a half-space).
         // and light from a ball's far side leaves it nearer the normal (far_light).
         float far = far_light.y > 0.0 ? clamp(far_light.x / far_light.y, 0.0, 1.0) : 0.0;
-        lo *= table_exit_factor(dipole_table, own_cos_t(), cos_o) * curvature_exit(dipole_table, pixel_curvature_rows, cos_o, far);
+        // Read at the mean incidence of the light it carries (entry_incidence).
+        float sin2_i = entry_incidence.y > 0.0 ? clamp(entry_incidence.x / entry_incidence.y, 0.0, 1.0) : 0.0;
+        lo *= table_exit_factor(dipole_table, own_cos_t(), cos_o)
+            * curvature_exit(dipole_table, pixel_curvature_rows, cos_o, far, sin2_i);
         if (across_thickness.y > 0.0) {
             float t = across_thickness.x / across_thickness.y;
             lo += fresnel_transmittance(object_params.channels[0].eta, cos_o) * across_sum

@@ -181,7 +181,7 @@ fn gpu_curvature_terms_match_cpu() {
         (state >> 11) as f64 / (1u64 << 53) as f64
     };
     let n = 4096;
-    let queries: Vec<[f32; 4]> = (0..n)
+    let queries: Vec<[[f32; 4]; 2]> = (0..n)
         .map(|i| {
             let r = 30.0 * unit * uniform().powi(2);
             let magnitude = 2f64.powf(-6.0 + 10.0 * uniform()) / unit;
@@ -190,7 +190,13 @@ fn gpu_curvature_terms_match_cpu() {
                 k if k % 2 == 1 => -magnitude,
                 _ => magnitude,
             };
-            [r as f32, kappa as f32, uniform() as f32, uniform() as f32]
+            // sin²θi per channel: normal, each row's own, between rows, past the last.
+            let sin2 = |u: f64| match i % 5 {
+                0 => 0.0,
+                1 => [0.0, 0.64, 0.96][(3.0 * u) as usize % 3],
+                _ => u,
+            };
+            [[r as f32, kappa as f32, uniform() as f32, uniform() as f32], [0, 1, 2, 3].map(|_| sin2(uniform()) as f32)]
         })
         .collect();
 
@@ -215,16 +221,22 @@ fn gpu_curvature_terms_match_cpu() {
     let near_boundary = |x: f64| x > 0.5 && (x - x.round()).abs() < 1e-4;
     let (mut checked, mut worst) = (0, [0.0f64; TERMS]);
     for (i, q) in queries.iter().enumerate() {
-        let [r, kappa, cos_o, far] = q.map(|v| v as f64);
+        let [r, kappa, cos_o, far] = q[0].map(|v| v as f64);
+        let sin2_i = [0, 1, 2].map(|c| q[1][c] as f64);
         let held = kappa.abs().min(curvature_profile::last_curvature(unit));
         let s = r * held;
         let tilt_u = r / (r + unit) * EXIT_TILT_ENTRIES as f64;
-        if near_boundary(s / (s + 1.0) * CURVATURE_TABLE_ENTRIES as f64) || near_boundary(tilt_u) {
+        // The rows of incidence are picked by the channels' mean sin²θi (f32 against f64 at 0.64).
+        let mean_sin2 = sin2_i.iter().sum::<f64>() / 3.0;
+        if near_boundary(s / (s + 1.0) * CURVATURE_TABLE_ENTRIES as f64)
+            || near_boundary(tilt_u)
+            || (mean_sin2 - curvature_profile::INCIDENCE_SIN2[1]).abs() < 1e-5
+        {
             continue;
         }
         let [c, g] = ratios.exit_tilt_at(r);
         let [b2, b3] = ratios.harmonics_at(r);
-        let cpu = [ratios.lookup(r, kappa), ratios.lookup_exit(cos_o, kappa, far), c, g, b2, b3, ratios.radial_at(r)];
+        let cpu = [ratios.lookup(r, kappa, sin2_i), ratios.lookup_exit(cos_o, kappa, far, q[1][3] as f64), c, g, b2, b3, ratios.radial_at(r)];
         for (k, expected) in cpu.iter().enumerate() {
             for ch in 0..3 {
                 let gpu = results[TERMS * i + k][ch] as f64;

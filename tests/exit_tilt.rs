@@ -92,7 +92,7 @@ fn model_rings(m: &Medium, ratios: &CurvatureChannel, r_mm: f64, toward: f64, ti
             let no = DVec3::new(a.sin(), 0.0, a.cos() * toward);
             let xo = r_mm * no;
             let along = view - view.dot(no) * no;
-            let (mut sum, mut far) = (0.0, 0.0);
+            let (mut sum, mut far, mut incidence) = (0.0, 0.0, 0.0);
             for k in 0..steps {
                 let theta = (k as f64 + 0.5) / steps as f64 * PI / 2.0;
                 let cos_i = theta.cos();
@@ -115,19 +115,22 @@ fn model_rings(m: &Medium, ratios: &CurvatureChannel, r_mm: f64, toward: f64, ti
                     let lean = profile.lean(chord, sin_t * cos_phi, sin_t * sin_t);
                     let kappa = curvature_profile::pair_curvature(d, n, no).unwrap_or(1.0 / r_mm);
                     let mut v =
-                        w * profile.incidence_factor(cos_t) * profile.sd(chord) * lean * ratios.ratio(chord, kappa);
+                        w * profile.incidence_factor(cos_t) * profile.sd(chord) * lean * ratios.ratio(chord, kappa, 1.0 - cos_i * cos_i);
                     let away = d - d.dot(no) * no;
                     if tilt && away.length() > 1e-12 {
                         let [c, g] = profile.exit_tilt_at(chord);
                         v *= (1.0 + c * along.dot(away.normalize()) + g * along.dot(ahead / m.eta)).max(0.0);
                     }
                     sum += v;
+                    incidence += v * (1.0 - cos_i * cos_i);
                     if chord * kappa >= 2f64.sqrt() {
                         far += v;
                     }
                 }
             }
             let far_share = if sum > 0.0 { far / sum } else { 0.0 };
+            // The light's mean sin²θi where it entered, by what each source sends (shade.frag).
+            let mean_sin2 = if sum > 0.0 { incidence / sum } else { 0.0 };
             sum *= (PI / 2.0 / steps as f64) * (2.0 * PI / steps as f64) * r_mm * r_mm;
             let cos_o = no.dot(view);
             // The pixel's own light: at its refracted angle where lit, normal incidence where not.
@@ -135,7 +138,7 @@ fn model_rings(m: &Medium, ratios: &CurvatureChannel, r_mm: f64, toward: f64, ti
                 if toward > 0.0 { (1.0 - (1.0 - cos_o * cos_o) / (m.eta * m.eta)).max(0.0).sqrt() } else { 1.0 };
             fresnel::transmittance(m.eta, cos_o)
                 * profile.exit_factor(cos_to, cos_o)
-                * ratios.exit_ratio(cos_o, 1.0 / r_mm, far_share)
+                * ratios.exit_ratio(cos_o, 1.0 / r_mm, far_share, mean_sin2)
                 * sum
         })
         .collect()
@@ -154,6 +157,13 @@ fn model_rings(m: &Medium, ratios: &CurvatureChannel, r_mm: f64, toward: f64, ti
 /// (`McProfile::radial`, 2026-12-07) the exitance near the pole rose to 0.984 0.984 1.006 of the
 /// walk (0.978 0.975 1.000) and red's radiance toward the eye in the next ring (0.3–0.5 of the
 /// radius) from 1.055 to 1.060: the same exit's direction, so that ring is held to 10% too.
+/// With the curvature rows per angle of incidence (2026-12-07: the ratio and the exit's rows,
+/// the latter read at the light's mean sin²θi by what each source sends) front-lit red 1.098
+/// 1.060 0.982 1.016 0.974 0.966 0.950 → 1.062 1.029 0.967 1.009 0.978 0.971 0.955, green 1.018
+/// 1.042 0.993 0.995 0.970 0.963 0.965 → 1.006 1.027 0.982 0.989 0.963 0.961 0.973; back-lit
+/// (printed) red 1.48 1.30 1.22 1.08 1.06 1.03 1.06 → 1.12 1.06 1.08 1.00 1.00 1.00 1.03, green
+/// 1.40 1.30 0.99 0.98 0.93 0.93 0.95 → 0.93 0.95 0.85 0.92 0.89 0.91 0.94. With the ratio's
+/// rows of incidence alone and the exit's of a normal beam, front-lit red's rim was 0.929.
 /// Lit from behind (printed; the walk's
 /// dark side is noisier), the outer rings (0.83 to 0.95 of the radius) are 1.03–1.07 in red and
 /// 0.86–0.90 in green (0.77–0.84 and 0.57–0.59 without the tilt, 0.81–0.85 in green with the

@@ -68,6 +68,22 @@ fn ketchup_thin_slab_against_the_path_tracer() {
 /// selection moves a back-lit mean by 4%). Each case is held to its measured ratio within 4%
 /// so that it fails if the model moves either way: a fix of a
 /// deficit updates the numbers here, with its cause.
+/// - **The ball's ratio per angle of incidence** (2026-12-07, curvature_profile's
+///   INCIDENCE_SIN2: the ratio's and the exit's rows for beams at cos θi 1, 0.6 and 0.2, read
+///   per pair at its light's sin²θi and per pixel at the mean of its light's): an oblique beam's
+///   light reaches a ball's far side less than a normal beam's (a 10 mm Skin1 ball's red 1.13–1.38
+///   of its exact walk past 135° from the light before, 0.98–1.01 to 145° now). Back-lit spheres:
+///   Skin1 1.059 1.024 0.992 → 1.006 0.999 0.993, Potato 1.046 1.056 1.078 → 0.995 1.004 1.021,
+///   Marble 0.998 1.009 0.999 → 0.990 0.999 0.996, Ketchup (recorded) 1.126 1.041 1.059 → 1.030
+///   1.039 1.059; the box 1.165 1.086 1.014 → 1.133 1.039 0.975; the torus back-lit 1.077 1.044
+///   1.014 → 1.042 1.014 1.005, front-lit 1.005 0.999 1.007 → 0.999 0.994 1.005; front-lit
+///   spheres: Skin1 1.004 1.000 0.999 → 0.997 0.996 0.997, Potato 1.023 1.023 1.002 → 1.017 1.016
+///   0.996, Marble 1.014 1.008 1.004 → 1.013 1.007 1.003, Ketchup (recorded) 0.918 0.983 0.976 →
+///   0.912 0.980 0.976. The bunnies: Skin1 1.056 0.955 0.913 → 1.008 0.909 0.874 (per-pixel
+///   relative RMSE 0.396 0.379 0.402 → 0.386 0.378 0.404; its multiple scattering alone about
+///   1.03 0.93 0.90 of the path tracer's, its single 0.84), Marble 1.030 1.003 0.959 → 1.023
+///   0.994 0.954; the far point light 1.028 0.979 0.972 → 1.022 0.973 0.968. The slabs and
+///   single scattering unchanged (flat: κ = 0).
 /// - **The radial profile's change with incidence** (2026-12-07, `McProfile::radial`): an oblique
 ///   beam's light spreads further than the normal beam's times f(θt), which the flat
 ///   half-space's walk measures (1.25–3.1 mm from a Skin1 beam at cos θi 0.2 the model was 0.88
@@ -176,17 +192,17 @@ fn ketchup_thin_slab_against_the_path_tracer() {
 fn curved_objects_against_the_path_tracer() {
     let brute = ["--brute-force", "--samples", "100000"];
     let cases: [(&str, &[&str], [f64; 3]); 11] = [
-        ("skin1/sphere-front", &brute, [1.004, 1.000, 0.999]),
-        ("skin1/sphere-back", &brute, [1.059, 1.024, 0.992]),
-        ("skin1/box-back", &brute, [1.165, 1.086, 1.014]),
-        ("skin1/torus-front", &brute, [1.005, 0.999, 1.007]),
-        ("skin1/torus-back", &brute, [1.077, 1.044, 1.014]),
-        ("skin1/bunny", &[], [1.056, 0.955, 0.913]),
-        ("marble/bunny", &[], [1.030, 1.003, 0.959]),
-        ("potato/sphere-front", &[], [1.023, 1.023, 1.002]),
-        ("marble/sphere-front", &[], [1.014, 1.008, 1.004]),
-        ("potato/sphere-back", &[], [1.046, 1.056, 1.078]),
-        ("marble/sphere-back", &[], [0.998, 1.009, 0.999]),
+        ("skin1/sphere-front", &brute, [0.997, 0.996, 0.997]),
+        ("skin1/sphere-back", &brute, [1.006, 0.999, 0.993]),
+        ("skin1/box-back", &brute, [1.133, 1.039, 0.975]),
+        ("skin1/torus-front", &brute, [0.999, 0.994, 1.005]),
+        ("skin1/torus-back", &brute, [1.042, 1.014, 1.005]),
+        ("skin1/bunny", &[], [1.008, 0.909, 0.874]),
+        ("marble/bunny", &[], [1.023, 0.994, 0.954]),
+        ("potato/sphere-front", &[], [1.017, 1.016, 0.996]),
+        ("marble/sphere-front", &[], [1.013, 1.007, 1.003]),
+        ("potato/sphere-back", &[], [0.995, 1.004, 1.021]),
+        ("marble/sphere-back", &[], [0.990, 0.999, 0.996]),
     ];
     for (name, sampling, expected) in cases {
         for (ch, ratio) in mc_against_its_reference(name, sampling).into_iter().enumerate() {

@@ -161,7 +161,8 @@ vec3 slab_exit_factor(usamplerBuffer table, vec4 header, float t, float cos_o) {
 // The Monte Carlo table's curvature ratios (mirrors gpu::sd_table::CurvatureRatios::lookup,
 // physics::curvature_profile::CurvatureChannel::ratio): C(r; κ), a sphere's (κ = 1/R > 0) or a
 // cavity's (κ < 0) multiple scattering over the half-space's at chord r, multiplying Sp(r).
-// After the light across: texel CURVATURE_BASE holds L (mm; 0: no ratios), then per side (convex,
+// After the light across: texel CURVATURE_BASE holds L (mm; 0: no ratios), then per angle of
+// incidence (CURVATURE_INCIDENCES, sin²θi 0, CURVATURE_SIN2_PERCENT_1/100, …_2/100) per side (convex,
 // concave) CURVATURE_NODES rows of CURVATURE_TABLE_ENTRIES texels at the centres of
 // u = s/(s + 1), s = r|κ| the chord relative to the ball's radius, row j's texel holding per
 // channel the ratios of nodes j − 1 (−1: flat, 1) and j (κ_j L = 2^(j + first)) at the same s
@@ -169,7 +170,8 @@ vec3 slab_exit_factor(usamplerBuffer table, vec4 header, float t, float cos_o) {
 // pixel): the row of κ (1/mm) and the weight of its upper node, linear in κ from flat to node 0
 // and in log κ between nodes, held past the last; z = |κ| (the last node's past it), w = L (0 and
 // x = −1: no ratios).
-// `curvature_ratio` (per pair): one fetch, the nearest entry.
+// `curvature_ratio` (per pair): the nearest entry of the two rows of incidence around the pair's
+// sin²θi (two fetches), linear in sin²θi between them per channel, held past the last.
 const int CURVATURE_BASE = SLAB_BASE + 1 + int(SLAB_LOOKUP_NODES * SLAB_ENTRIES + SLAB_THICKNESS_NODES * MC_EXIT_BINS);
 const float CURVATURE_FIRST_LOG2 = float(CURVATURE_FIRST_LOG2_PLUS_8) - 8.0;
 vec4 curvature_rows_at(float unit_mm, float kappa);
@@ -190,33 +192,55 @@ vec4 curvature_rows_at(float unit_mm, float kappa) {
     float held = min(x, exp2(CURVATURE_FIRST_LOG2 + float(CURVATURE_NODES - 1u)));
     return vec4(side + i + 1.0, k - i, held / unit_mm, unit_mm);
 }
-vec3 curvature_ratio(usamplerBuffer table, vec4 rows, float r_mm) {
+const int CURVATURE_INCIDENCE_ROWS = 2 * int(CURVATURE_NODES * CURVATURE_TABLE_ENTRIES);
+vec3 curvature_ratio(usamplerBuffer table, vec4 rows, float r_mm, vec3 sin2_i) {
     if (rows.x < 0.0) return vec3(1.0);
     float s = r_mm * rows.z;
     int e = min(int(s / (s + 1.0) * float(CURVATURE_TABLE_ENTRIES)), int(CURVATURE_TABLE_ENTRIES) - 1);
-    uvec3 pairs = texelFetch(table, CURVATURE_BASE + 1 + int(rows.x) * int(CURVATURE_TABLE_ENTRIES) + e).xyz;
-    vec2 red = unpackHalf2x16(pairs.x), green = unpackHalf2x16(pairs.y), blue = unpackHalf2x16(pairs.z);
-    return mix(vec3(red.x, green.x, blue.x), vec3(red.y, green.y, blue.y), rows.y);
+    // Two rows of incidence, bracketing the channels' mean sin²θi (one light: every channel's);
+    // each channel's weight between them clamped (mirrors CurvatureRatios::lookup; NaN: normal).
+    const float s1 = float(CURVATURE_SIN2_PERCENT_1) / 100.0, s2 = float(CURVATURE_SIN2_PERCENT_2) / 100.0;
+    vec3 q = mix(vec3(0.0), sin2_i, equal(sin2_i, sin2_i));
+    bool upper = (q.x + q.y + q.z) / 3.0 >= s1;
+    vec3 weight = upper ? clamp((q - s1) / (s2 - s1), 0.0, 1.0) : clamp(q / s1, 0.0, 1.0);
+    int t = CURVATURE_BASE + 1 + (upper ? CURVATURE_INCIDENCE_ROWS : 0) + int(rows.x) * int(CURVATURE_TABLE_ENTRIES) + e;
+    vec3 at[2];
+    for (int j = 0; j < 2; ++j) {
+        uvec3 pairs = texelFetch(table, t + j * CURVATURE_INCIDENCE_ROWS).xyz;
+        vec2 red = unpackHalf2x16(pairs.x), green = unpackHalf2x16(pairs.y), blue = unpackHalf2x16(pairs.z);
+        at[j] = mix(vec3(red.x, green.x, blue.x), vec3(red.y, green.y, blue.y), rows.y);
+    }
+    return mix(at[0], at[1], weight);
 }
 
 // The exit distribution's curvature ratio (mirrors gpu::sd_table::CurvatureRatios::lookup_exit,
 // physics::curvature_profile::CurvatureChannel::exit_ratio), multiplying the exit factor h: after
-// the ratio rows, per side the same pairing of nodes in rows of MC_EXIT_BINS texels; linear in
-// cos²θo between the bins' centres, held beyond the outer ones. `rows` from curvature_rows. Then
-// the same rows of the light from beyond a chord R√2, mixed in by `far` (its share).
-vec3 curvature_exit(usamplerBuffer table, vec4 rows, float cos_o, float far) {
+// the ratio rows, per angle of incidence per side the same pairing of nodes in rows of
+// MC_EXIT_BINS texels, then the same rows of the light from beyond a chord R√2; linear in
+// cos²θo between the bins' centres, held beyond the outer ones. `rows` from curvature_rows;
+// `far` the far light's share; `sin2_i` the light's mean sin²θi where it entered, linear
+// between the rows of incidence (held past the last).
+const int CURVATURE_EXIT_ROWS = 4 * int(CURVATURE_NODES * MC_EXIT_BINS); // per angle of incidence
+vec3 curvature_exit(usamplerBuffer table, vec4 rows, float cos_o, float far, float sin2_i) {
     if (rows.x < 0.0) return vec3(1.0);
-    int base = CURVATURE_BASE + 1 + 2 * int(CURVATURE_NODES * CURVATURE_TABLE_ENTRIES) + int(rows.x) * int(MC_EXIT_BINS);
+    const float s1 = float(CURVATURE_SIN2_PERCENT_1) / 100.0, s2 = float(CURVATURE_SIN2_PERCENT_2) / 100.0;
+    float q = sin2_i >= 0.0 ? sin2_i : 0.0; // NaN: normal incidence
+    bool upper = q >= s1;
+    float weight = upper ? clamp((q - s1) / (s2 - s1), 0.0, 1.0) : clamp(q / s1, 0.0, 1.0);
+    int base = CURVATURE_BASE + 1 + int(CURVATURE_INCIDENCES) * CURVATURE_INCIDENCE_ROWS
+             + (upper ? CURVATURE_EXIT_ROWS : 0) + int(rows.x) * int(MC_EXIT_BINS);
     float y = clamp(cos_o * cos_o * float(MC_EXIT_BINS) - 0.5, 0.0, float(MC_EXIT_BINS - 1u));
     float j = min(floor(y), float(MC_EXIT_BINS - 2u));
-    vec3 at[4];
-    for (int k = 0; k < 4; ++k) {
-        int far_rows = (k / 2) * 2 * int(CURVATURE_NODES * MC_EXIT_BINS);
+    vec3 at[8];
+    for (int k = 0; k < 8; ++k) {
+        int far_rows = ((k / 2) % 2) * 2 * int(CURVATURE_NODES * MC_EXIT_BINS) + (k / 4) * CURVATURE_EXIT_ROWS;
         uvec3 pairs = texelFetch(table, base + far_rows + int(j) + k % 2).xyz;
         vec2 red = unpackHalf2x16(pairs.x), green = unpackHalf2x16(pairs.y), blue = unpackHalf2x16(pairs.z);
         at[k] = mix(vec3(red.x, green.x, blue.x), vec3(red.y, green.y, blue.y), rows.y);
     }
-    return mix(mix(at[0], at[1], y - j), mix(at[2], at[3], y - j), far);
+    vec3 lower_row = mix(mix(at[0], at[1], y - j), mix(at[2], at[3], y - j), far);
+    vec3 upper_row = mix(mix(at[4], at[5], y - j), mix(at[6], at[7], y - j), far);
+    return mix(lower_row, upper_row, weight);
 }
 
 // The Monte Carlo table's terms per distance r after the curvature rows, at one entry for both
@@ -229,7 +253,7 @@ vec3 curvature_exit(usamplerBuffer table, vec4 rows, float cos_o, float far) {
 // each texel f16 pairs (x_r, x_g), (x_b, y_r), (y_g, y_b). `with_tilt` false: the tilt is not
 // fetched (no exit direction) and is 0.
 const int EXIT_TILT_BASE =
-    CURVATURE_BASE + 1 + 2 * int(CURVATURE_NODES * CURVATURE_TABLE_ENTRIES) + 4 * int(CURVATURE_NODES * MC_EXIT_BINS);
+    CURVATURE_BASE + 1 + int(CURVATURE_INCIDENCES) * (CURVATURE_INCIDENCE_ROWS + CURVATURE_EXIT_ROWS);
 // Six f16 of texel `t` as two vec3: (a_r, a_g), (a_b, b_r), (b_g, b_b).
 void two_rgb_halves(usamplerBuffer table, int t, out vec3 a, out vec3 b) {
     uvec3 pairs = texelFetch(table, t).xyz;

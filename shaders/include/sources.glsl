@@ -27,10 +27,20 @@ float pixel_curvature_mm = 0.0;
 // The light of the object's sources, by luminance: x from beyond a chord R√2 of the pair's ball
 // (rκ ≥ √2: the far hemisphere of a ball, none on a plane), y all of it. It leaves nearer the
 // normal (curvature_exit's far rows), weighed by x/y per pixel.
+// And the light's sin²θi where it entered, by luminance (Σ luminance·sin²θi, Σ luminance): the
+// exit's rows are read at its mean (curvature_exit). The far-field pass's sources are taken at
+// the mean of the rest (its samples carry the far share only).
 vec2 far_light = vec2(0.0);
-void count_far(float r_kappa, vec3 contribution) {
+vec2 entry_incidence = vec2(0.0);
+void count_far(float r_kappa, vec3 contribution, float sin2_i) {
     float luminance = dot(contribution, LUMINANCE);
     far_light += vec2(r_kappa >= 1.41421356 ? luminance : 0.0, luminance);
+    entry_incidence += vec2(luminance * sin2_i, luminance);
+}
+// sin²θi of light from `toward` (the direction toward it, unit or a mean) at a source of normal ni.
+float entry_sin2(vec3 toward, vec3 ni) {
+    float along = dot(toward, ni);
+    return clamp(dot(toward, toward) - along * along, 0.0, 1.0);
 }
 
 float pair_curvature(vec3 d, vec3 ni, vec3 no) {
@@ -106,7 +116,7 @@ vec3 mc_sd(vec3 d, vec3 ni, float kappa, vec3 toward[3]) {
     vec3 harmonics = (vec3(1.0) + a * m2)
                    * (vec3(1.0) + b * lean + b2 * (2.0 * lean * lean - m2) + b3 * (4.0 * lean * lean - 3.0 * m2) * lean);
     return sd * max(harmonics, vec3(0.0)) * tilt
-        * curvature_ratio(dipole_table, curvature_rows_at(pixel_curvature_rows.w, kappa), r);
+        * curvature_ratio(dipole_table, curvature_rows_at(pixel_curvature_rows.w, kappa), r, (eta * eta) * m2);
 }
 
 // Points nearer than this many diffusion lengths (1/σtr) of the farthest-reaching channel are
@@ -155,7 +165,7 @@ vec3 source(vec3 xi, vec3 ni, vec3 wi, vec3 power, vec3 xo, vec3 no) {
         vec3 d = (xo - xi) * s;
         float kappa = pair_curvature(d, ni, no);
         sd = across(xi, ni, xo, no, mc_sd(d, ni, kappa, toward), power * (s * s));
-        count_far(length(d) * kappa, sd * power * (s * s));
+        count_far(length(d) * kappa, sd * power * (s * s), entry_sin2(wi, ni));
     } else {
         sd = dipole_sd_table(dipole_table, dipole_header, length(xo - xi) * s);
     }
@@ -192,7 +202,7 @@ vec3 merged_source(vec3 xi, vec3 ni, vec3 power, vec4 incident[3], vec3 dw, vec3
         sd = mc_sd(d, ni, kappa, toward);
         if (across_object) {
             sd = across(xi, ni, xo, no, sd, power * (s * s));
-            count_far(length(d) * kappa, sd * power * (s * s));
+            count_far(length(d) * kappa, sd * power * (s * s), entry_sin2(toward[1], ni));
         }
     } else {
         sd = dipole_sd_table(dipole_table, dipole_header, length(xo - xi) * s);

@@ -32,6 +32,12 @@ pub const SLAB_FIRST_NODE_LOG2_PLUS_8: u32 = 4;
 pub const CURVATURE_NODES: u32 = 8;
 pub const CURVATURE_FIRST_LOG2_PLUS_8: u32 = 4;
 pub const CURVATURE_TABLE_ENTRIES: u32 = 1024;
+/// The angles of incidence of the curvature ratio rows (curvature_profile's INCIDENCE_SIN2, checked
+/// equal in gpu::sd_table): their count, and sin²θi of the second and third in hundredths (the
+/// first is normal incidence).
+pub const CURVATURE_INCIDENCES: u32 = 3;
+pub const CURVATURE_SIN2_PERCENT_1: u32 = 64;
+pub const CURVATURE_SIN2_PERCENT_2: u32 = 96;
 /// Entries of the Monte Carlo table's exit tilt, after the curvature rows.
 pub const EXIT_TILT_ENTRIES: u32 = 256;
 
@@ -80,6 +86,9 @@ pub const GLSL_CONSTANTS: &[(&str, u32)] = &[
     ("SLAB_FIRST_NODE_LOG2_PLUS_8", SLAB_FIRST_NODE_LOG2_PLUS_8),
     ("CURVATURE_NODES", CURVATURE_NODES),
     ("CURVATURE_TABLE_ENTRIES", CURVATURE_TABLE_ENTRIES),
+    ("CURVATURE_INCIDENCES", CURVATURE_INCIDENCES),
+    ("CURVATURE_SIN2_PERCENT_1", CURVATURE_SIN2_PERCENT_1),
+    ("CURVATURE_SIN2_PERCENT_2", CURVATURE_SIN2_PERCENT_2),
     ("EXIT_TILT_ENTRIES", EXIT_TILT_ENTRIES),
     ("CURVATURE_FIRST_LOG2_PLUS_8", CURVATURE_FIRST_LOG2_PLUS_8),
     ("LEAF_BIT", LEAF_BIT),

@@ -299,6 +299,10 @@ impl SlabTransmission {
 
 const _: () = assert!(curvature_profile::CURVATURE_NODES == super::CURVATURE_NODES as usize);
 const _: () = assert!(curvature_profile::FIRST_CURVATURE_LOG2 + 8 == super::CURVATURE_FIRST_LOG2_PLUS_8 as i32);
+const _: () = assert!(curvature_profile::INCIDENCES == super::CURVATURE_INCIDENCES as usize);
+const _: () = assert!(curvature_profile::INCIDENCE_SIN2[0] == 0.0);
+const _: () = assert!(curvature_profile::INCIDENCE_SIN2[1] == super::CURVATURE_SIN2_PERCENT_1 as f64 / 100.0);
+const _: () = assert!(curvature_profile::INCIDENCE_SIN2[2] == super::CURVATURE_SIN2_PERCENT_2 as f64 / 100.0);
 
 /// Entries per row of [`CurvatureRatios`] (bssrdf.glsl reads the nearest: fine enough that
 /// rounding r moves a ratio by under 1%; tests/curvature_profile.rs).
@@ -311,11 +315,11 @@ pub const EXIT_TILT_ENTRIES: usize = super::EXIT_TILT_ENTRIES as usize;
 /// CURVATURE_TABLE_ENTRIES centres of u = s/(s + 1), s = r·κ the chord relative to the node's
 /// radius, so that a texel pairs two nodes at the same place on their balls, as
 /// [`CurvatureChannel::ratio`] reads them): a header texel (L in mm; 0 for the other
-/// models, which never read the rest), then 2N rows of entries, each texel holding per channel
-/// two neighbouring curvature nodes' ratios as two f16, so that one fetch interpolates in κ: on
-/// each side (convex, then concave) row j holds nodes j − 1 and j, node −1 being the flat
-/// surface (every ratio 1). Then the exit distribution's ratios (`curvature_exit`;
-/// [`CurvatureChannel::exit_ratio`]): the same 2N rows of MC_EXIT_BINS texels, paired the same way,
+/// models, which never read the rest), then per angle of incidence (curvature_profile's
+/// INCIDENCE_SIN2) 2N rows of entries, each texel holding per channel two neighbouring curvature
+/// nodes' ratios as two f16, so that one fetch interpolates in κ: on each side (convex, then
+/// concave) row j holds nodes j − 1 and j, node −1 being the flat surface (every ratio 1). Then the exit distribution's ratios (`curvature_exit`;
+/// [`CurvatureChannel::exit_ratio`]): per angle of incidence the same 2N rows of MC_EXIT_BINS texels, paired the same way,
 /// of the light from within a chord R√2, then 2N more of the light from beyond it. Then the
 /// Monte Carlo table's exit tilt [c, g] ([`McProfile::exit_tilt_at`]) at EXIT_TILT_ENTRIES
 /// centres of u = r/(r + L), one texel each: f16 pairs (c_r, c_g), (c_b, g_r), (g_g, g_b)
@@ -327,14 +331,14 @@ pub const EXIT_TILT_ENTRIES: usize = super::EXIT_TILT_ENTRIES as usize;
 #[derive(Clone, Debug, PartialEq)]
 pub struct CurvatureRatios {
     pub unit_mm: f32,
-    /// Per side, per node, per entry, per channel.
-    pub convex: Vec<Vec<[f32; 3]>>,
-    pub concave: Vec<Vec<[f32; 3]>>,
-    /// Per side, per node, per exit bin, per channel.
-    pub convex_exit: Vec<Vec<[f32; 3]>>,
-    pub concave_exit: Vec<Vec<[f32; 3]>>,
-    pub convex_exit_far: Vec<Vec<[f32; 3]>>,
-    pub concave_exit_far: Vec<Vec<[f32; 3]>>,
+    /// Per angle of incidence, per side, per node, per entry, per channel.
+    pub convex: [Vec<Vec<[f32; 3]>>; curvature_profile::INCIDENCES],
+    pub concave: [Vec<Vec<[f32; 3]>>; curvature_profile::INCIDENCES],
+    /// Per angle of incidence, per side, per node, per exit bin, per channel.
+    pub convex_exit: [Vec<Vec<[f32; 3]>>; curvature_profile::INCIDENCES],
+    pub concave_exit: [Vec<Vec<[f32; 3]>>; curvature_profile::INCIDENCES],
+    pub convex_exit_far: [Vec<Vec<[f32; 3]>>; curvature_profile::INCIDENCES],
+    pub concave_exit_far: [Vec<Vec<[f32; 3]>>; curvature_profile::INCIDENCES],
     /// Per entry, [c, g] per channel.
     pub exit_tilt: Vec<[[f32; 3]; 2]>,
     /// Per entry, [b₂, b₃] per channel.
@@ -352,12 +356,12 @@ impl CurvatureRatios {
         let flat_exit = vec![vec![[1.0; 3]; mc_profile::EXIT_BINS]; curvature_profile::CURVATURE_NODES];
         CurvatureRatios {
             unit_mm: 0.0,
-            convex: flat.clone(),
-            concave: flat,
-            convex_exit: flat_exit.clone(),
-            concave_exit: flat_exit.clone(),
-            convex_exit_far: flat_exit.clone(),
-            concave_exit_far: flat_exit,
+            convex: std::array::from_fn(|_| flat.clone()),
+            concave: std::array::from_fn(|_| flat.clone()),
+            convex_exit: std::array::from_fn(|_| flat_exit.clone()),
+            concave_exit: std::array::from_fn(|_| flat_exit.clone()),
+            convex_exit_far: std::array::from_fn(|_| flat_exit.clone()),
+            concave_exit_far: std::array::from_fn(|_| flat_exit.clone()),
             exit_tilt: vec![[[0.0; 3]; 2]; EXIT_TILT_ENTRIES],
             harmonics: vec![[[0.0; 3]; 2]; EXIT_TILT_ENTRIES],
             radial: vec![[[0.0; 3]; 2]; EXIT_TILT_ENTRIES],
@@ -370,7 +374,7 @@ impl CurvatureRatios {
         profiles: &[std::sync::Arc<McProfile>; 3],
     ) -> CurvatureRatios {
         let unit = channels[0].unit_mm;
-        let nodes = |sign: f64| -> Vec<Vec<[f32; 3]>> {
+        let nodes = |sign: f64, j: usize| -> Vec<Vec<[f32; 3]>> {
             (0..curvature_profile::CURVATURE_NODES)
                 .map(|k| {
                     let radius = unit / curvature_profile::node_curvature(k);
@@ -378,13 +382,13 @@ impl CurvatureRatios {
                         .map(|i| {
                             let u = (i as f64 + 0.5) / CURVATURE_TABLE_ENTRIES as f64;
                             let chord = radius * u / (1.0 - u);
-                            [0, 1, 2].map(|c| channels[c].node_ratio(sign < 0.0, k, chord) as f32)
+                            [0, 1, 2].map(|c| channels[c].node_ratio(sign < 0.0, j, k, chord) as f32)
                         })
                         .collect()
                 })
                 .collect()
         };
-        let exits = |concave: bool, far: bool| -> Vec<Vec<[f32; 3]>> {
+        let exits = |concave: bool, far: bool, j: usize| -> Vec<Vec<[f32; 3]>> {
             (0..curvature_profile::CURVATURE_NODES)
                 .map(|k| {
                     (0..mc_profile::EXIT_BINS)
@@ -397,7 +401,7 @@ impl CurvatureRatios {
                                     (false, true) => &ch.convex_exit_far,
                                     (true, true) => &ch.concave_exit_far,
                                 };
-                                rows[k][b] as f32
+                                rows[j][k][b] as f32
                             })
                         })
                         .collect()
@@ -419,12 +423,12 @@ impl CurvatureRatios {
         };
         CurvatureRatios {
             unit_mm: unit as f32,
-            convex: nodes(1.0),
-            concave: nodes(-1.0),
-            convex_exit: exits(false, false),
-            concave_exit: exits(true, false),
-            convex_exit_far: exits(false, true),
-            concave_exit_far: exits(true, true),
+            convex: std::array::from_fn(|j| nodes(1.0, j)),
+            concave: std::array::from_fn(|j| nodes(-1.0, j)),
+            convex_exit: std::array::from_fn(|j| exits(false, false, j)),
+            concave_exit: std::array::from_fn(|j| exits(true, false, j)),
+            convex_exit_far: std::array::from_fn(|j| exits(false, true, j)),
+            concave_exit_far: std::array::from_fn(|j| exits(true, true, j)),
             exit_tilt: per_exit_entry(&|c, r| profiles[c].exit_tilt_at(r)),
             harmonics: per_exit_entry(&|c, r| profiles[c].higher_harmonics(r)),
             radial: per_exit_entry(&|c, r| [profiles[c].radial_at(r), 0.0]),
@@ -484,13 +488,17 @@ impl CurvatureRatios {
                 })
                 .collect()
         };
+        let ratios = (0..curvature_profile::INCIDENCES).flat_map(|j| {
+            side(&self.convex[j], CURVATURE_TABLE_ENTRIES).into_iter().chain(side(&self.concave[j], CURVATURE_TABLE_ENTRIES))
+        });
         header
-            .chain(side(&self.convex, CURVATURE_TABLE_ENTRIES))
-            .chain(side(&self.concave, CURVATURE_TABLE_ENTRIES))
-            .chain(side(&self.convex_exit, mc_profile::EXIT_BINS))
-            .chain(side(&self.concave_exit, mc_profile::EXIT_BINS))
-            .chain(side(&self.convex_exit_far, mc_profile::EXIT_BINS))
-            .chain(side(&self.concave_exit_far, mc_profile::EXIT_BINS))
+            .chain(ratios)
+            .chain((0..curvature_profile::INCIDENCES).flat_map(|j| {
+                [&self.convex_exit[j], &self.concave_exit[j], &self.convex_exit_far[j], &self.concave_exit_far[j]]
+                    .into_iter()
+                    .flat_map(|rows| side(rows, mc_profile::EXIT_BINS))
+                    .collect::<Vec<_>>()
+            }))
             .chain(self.exit_tilt.iter().chain(&self.harmonics).chain(&self.radial).map(|[a, b]| {
                 let pair = |x: f32, y: f32| half_bits(x) as u32 | (half_bits(y) as u32) << 16;
                 [pair(a[0], a[1]), pair(a[2], b[0]), pair(b[1], b[2]), 0]
@@ -501,26 +509,32 @@ impl CurvatureRatios {
     /// The exit distribution's ratio per channel at exit cosine `cos_o` and curvature `kappa`
     /// (1/mm), as the shade pass reads it (`curvature_exit`): linear in cos²θo between bin
     /// centres (held beyond the outer ones), in κ as [`CurvatureRatios::lookup`], the rows of
-    /// near and far light mixed by `far` (the share of the light from beyond a chord R√2).
-    pub fn lookup_exit(&self, cos_o: f64, kappa: f64, far: f64) -> [f64; 3] {
+    /// near and far light mixed by `far` (the share of the light from beyond a chord R√2), and
+    /// linear in the light's mean sin²θi `sin2_i` between the rows of incidence.
+    pub fn lookup_exit(&self, cos_o: f64, kappa: f64, far: f64, sin2_i: f64) -> [f64; 3] {
         let unit = self.unit_mm as f64;
         if unit.is_nan() || unit <= 0.0 {
             return [1.0; 3];
         }
-        let (near_nodes, far_nodes) = if kappa < 0.0 {
-            (&self.concave_exit, &self.concave_exit_far)
-        } else {
-            (&self.convex_exit, &self.convex_exit_far)
-        };
         let y = (cos_o * cos_o * mc_profile::EXIT_BINS as f64 - 0.5).clamp(0.0, (mc_profile::EXIT_BINS - 1) as f64);
         let j = (y.floor() as usize).min(mc_profile::EXIT_BINS - 2);
+        let (row, g) = curvature_profile::incidence_rows(sin2_i);
         [0, 1, 2].map(|c| {
-            let read = |nodes: &[Vec<[f32; 3]>]| {
-                let at = |b: usize| self.between_nodes(nodes, kappa, b, c);
-                at(j) + (at(j + 1) - at(j)) * (y - j as f64)
+            let at_incidence = |i: usize| {
+                let (near_nodes, far_nodes) = if kappa < 0.0 {
+                    (&self.concave_exit[i], &self.concave_exit_far[i])
+                } else {
+                    (&self.convex_exit[i], &self.convex_exit_far[i])
+                };
+                let read = |nodes: &[Vec<[f32; 3]>]| {
+                    let at = |b: usize| self.between_nodes(nodes, kappa, b, c);
+                    at(j) + (at(j + 1) - at(j)) * (y - j as f64)
+                };
+                let (near, beyond) = (read(near_nodes), read(far_nodes));
+                near + (beyond - near) * far
             };
-            let (near, beyond) = (read(near_nodes), read(far_nodes));
-            near + (beyond - near) * far
+            let (a, b) = (at_incidence(row), at_incidence(row + 1));
+            a + (b - a) * g
         })
     }
 
@@ -533,23 +547,36 @@ impl CurvatureRatios {
         a + (value(nodes[upper][i][c]) - a) * f
     }
 
-    /// The ratio per channel at chord `r_mm` and curvature `kappa` (1/mm), as the shade pass
-    /// reads it: the nearest entry, linear in κ from the flat surface to node 0 and in log κ
-    /// between nodes, held past the last.
-    pub fn lookup(&self, r_mm: f64, kappa: f64) -> [f64; 3] {
+    /// The ratio per channel at chord `r_mm` and curvature `kappa` (1/mm) of light that entered
+    /// at sin²θi = `sin2_i` (per channel), as the shade pass reads it: the nearest entry, linear
+    /// in κ from the flat surface to node 0 and in log κ between nodes, held past the last, and
+    /// linear in sin²θi between the two rows of incidence around the channels' mean
+    /// (curvature_profile::incidence_rows), each channel's weight clamped to them: two fetches,
+    /// exact where the channels share their light's direction.
+    pub fn lookup(&self, r_mm: f64, kappa: f64, sin2_i: [f64; 3]) -> [f64; 3] {
         let unit = self.unit_mm as f64;
         if unit.is_nan() || unit <= 0.0 {
             return [1.0; 3];
         }
-        let nodes = if kappa < 0.0 { &self.concave } else { &self.convex };
+        let rows = if kappa < 0.0 { &self.concave } else { &self.convex };
         let s = if kappa.is_nan() { 0.0 } else { r_mm * kappa.abs().min(curvature_profile::last_curvature(unit)) };
         let e = ((s / (s + 1.0) * CURVATURE_TABLE_ENTRIES as f64) as usize).min(CURVATURE_TABLE_ENTRIES - 1);
-        [0, 1, 2].map(|c| self.between_nodes(nodes, kappa, e, c))
+        // Two rows, around the channels' mean sin²θi (one light: each channel's own); each
+        // channel's weight between them clamped (NaN: normal incidence).
+        let q = sin2_i.map(|x| if x.is_nan() { 0.0 } else { x });
+        let (j, _) = curvature_profile::incidence_rows((q[0] + q[1] + q[2]) / 3.0);
+        let (lo, hi) = (curvature_profile::INCIDENCE_SIN2[j], curvature_profile::INCIDENCE_SIN2[j + 1]);
+        [0, 1, 2].map(|c| {
+            let g = ((q[c] - lo) / (hi - lo)).clamp(0.0, 1.0);
+            let (a, b) = (self.between_nodes(&rows[j], kappa, e, c), self.between_nodes(&rows[j + 1], kappa, e, c));
+            a + (b - a) * g
+        })
     }
 
     /// Texels after the light across.
-    pub const TEXELS: usize =
-        1 + Self::ROWS * (CURVATURE_TABLE_ENTRIES + 2 * mc_profile::EXIT_BINS) + 3 * EXIT_TILT_ENTRIES;
+    pub const TEXELS: usize = 1
+        + Self::ROWS * curvature_profile::INCIDENCES * (CURVATURE_TABLE_ENTRIES + 2 * mc_profile::EXIT_BINS)
+        + 3 * EXIT_TILT_ENTRIES;
 }
 
 /// Beam diffusion's entry at `r` of a table of `reach`: Sd, but at r = 0 the v0 for which the

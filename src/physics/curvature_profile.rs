@@ -36,6 +36,18 @@
 //! it read low there (green 0.85-0.99 of a 10 mm Skin1 ball's exact walk past 1.1R, 0.93-1.04
 //! split).
 //!
+//! The rows are measured for beams at three angles of incidence (INCIDENCE_SIN2: cos θi 1, 0.6,
+//! 0.2), each ball against the half-space lit by the same beam (the profile the shade pass
+//! draws for it: M(r) f(θt) (1 + a(r) sin²θt)), and read per pair at its light's sin²θi. An
+//! oblique beam enters shallower and nearer the surface that bends away from it, so less of its
+//! light reaches a ball's far side: Skin1's red row at R = L/2 (node 4) holds 5.0 at its
+//! antipode for a normal beam, 3.0 at cos θi 0.2. Read with the normal beam's rows alone, a 10 mm
+//! Skin1 ball lit from the front was 1.13-1.38 of its exact walk in red past 135° from the light.
+//! The exit's rows below are kept per angle of incidence too, and read per pixel at the mean
+//! sin²θi of the light it gathers (weighted by what each source sends): read at a normal beam's,
+//! a front-lit 10 mm Skin1 ball's rim was 0.93 of the walk's radiance toward the eye in red and
+//! a back-lit one's centre 1.48 (tests/exit_tilt.rs), now 0.955 and 1.12.
+//!
 //! The same walks give the exit's direction: a ball lets less light out at grazing angles and
 //! more near its normal than the half-space (looking back inside at a grazing exit, a chord of
 //! the ball ends where the half-space's ray would go on into lit depth). Per node, the ratio of
@@ -56,6 +68,16 @@ use std::sync::{Arc, Mutex, OnceLock};
 
 /// Nodes per sign of curvature, an octave apart.
 pub const CURVATURE_NODES: usize = 8;
+/// The angles of incidence whose beams the ratio rows are measured with, as sin²θi outside
+/// (cos θi 1, 0.6, 0.2): a ball's light from an oblique beam reaches its far side less, against
+/// the half-space's oblique beam, than a normal beam's does (the 10 mm Skin1 ball's red past 95°
+/// from the light was 1.04-1.38 of its exact walk read with the normal beam's rows alone,
+/// 0.99-1.005 to 145° with these; tests/curvature_profile.rs `the_front_lit_sphere_ring_by_ring`).
+/// Linear in sin²θi between them, held past the last (what the shade pass has per pair is
+/// η²|m|², m the refracted direction's part along the surface).
+pub const INCIDENCE_SIN2: [f64; 3] = [0.0, 0.64, 0.96];
+/// Rows per node and sign: one per angle of incidence.
+pub const INCIDENCES: usize = INCIDENCE_SIN2.len();
 /// κ_0·L = 2^FIRST_CURVATURE_LOG2.
 pub const FIRST_CURVATURE_LOG2: i32 = -4;
 /// Radial entries per node, at the centres of u = r/(r + L) ∈ [i, i + 1)/ENTRIES (96: at 48 the
@@ -121,6 +143,21 @@ pub fn pair_curvature(d: DVec3, ni: DVec3, no: DVec3) -> Option<f64> {
     (r2 > 0.0).then(|| (no - ni).dot(d) / r2)
 }
 
+/// The row of incidence below sin²θi = `sin2_i` and the weight of the next (NaN: normal incidence).
+pub fn incidence_rows(sin2_i: f64) -> (usize, f64) {
+    if sin2_i.is_nan() {
+        return (0, 0.0);
+    }
+    let j = INCIDENCE_SIN2[1..INCIDENCES - 1].iter().take_while(|&&s| sin2_i >= s).count();
+    let (a, b) = (INCIDENCE_SIN2[j], INCIDENCE_SIN2[j + 1]);
+    (j, ((sin2_i - a) / (b - a)).clamp(0.0, 1.0))
+}
+
+/// The cosine of incidence (outside) of row `j`.
+pub fn incidence_cos(j: usize) -> f64 {
+    (1.0 - INCIDENCE_SIN2[j]).sqrt()
+}
+
 /// The centre of entry `i` in u.
 pub fn entry_centre(i: usize) -> f64 {
     (i as f64 + 0.5) / ENTRIES as f64
@@ -131,25 +168,29 @@ pub fn entry_centre(i: usize) -> f64 {
 pub struct CurvatureChannel {
     /// L, mm.
     pub unit_mm: f64,
-    /// Per node (convex, then concave), per entry.
-    pub convex: Vec<[f64; ENTRIES]>,
-    pub concave: Vec<[f64; ENTRIES]>,
+    /// Per angle of incidence (INCIDENCE_SIN2), per node (convex, then concave), per entry.
+    pub convex: [Vec<[f64; ENTRIES]>; INCIDENCES],
+    pub concave: [Vec<[f64; ENTRIES]>; INCIDENCES],
     /// Per node, per exit bin (the Monte Carlo table's, in cos²θo): the exit distribution's ratio
     /// of the light that leaves within a chord R√2 of where it entered.
-    pub convex_exit: Vec<[f64; EXIT_BINS]>,
-    pub concave_exit: Vec<[f64; EXIT_BINS]>,
+    /// Per angle of incidence as the ratios.
+    pub convex_exit: [Vec<[f64; EXIT_BINS]>; INCIDENCES],
+    pub concave_exit: [Vec<[f64; EXIT_BINS]>; INCIDENCES],
     /// The same of the light that leaves farther (a ball's far hemisphere): nearer the normal.
-    pub convex_exit_far: Vec<[f64; EXIT_BINS]>,
-    pub concave_exit_far: Vec<[f64; EXIT_BINS]>,
+    pub convex_exit_far: [Vec<[f64; EXIT_BINS]>; INCIDENCES],
+    pub concave_exit_far: [Vec<[f64; EXIT_BINS]>; INCIDENCES],
 }
 
 impl super::table_cache::Flat for CurvatureChannel {
     fn to_flat(&self) -> Vec<f64> {
         let mut v = vec![self.unit_mm];
-        for rows in [&self.convex, &self.concave] {
+        for rows in self.convex.iter().chain(&self.concave) {
             super::table_cache::push_vec(&mut v, rows.iter().flatten().copied().collect::<Vec<_>>().into_iter());
         }
-        for rows in [&self.convex_exit, &self.concave_exit, &self.convex_exit_far, &self.concave_exit_far] {
+        for rows in [&self.convex_exit, &self.concave_exit, &self.convex_exit_far, &self.concave_exit_far]
+            .into_iter()
+            .flatten()
+        {
             super::table_cache::push_vec(&mut v, rows.iter().flatten().copied().collect::<Vec<_>>().into_iter());
         }
         v
@@ -161,9 +202,13 @@ impl super::table_cache::Flat for CurvatureChannel {
             (flat.len() == N * CURVATURE_NODES)
                 .then(|| flat.chunks_exact(N).filter_map(|c| c.try_into().ok()).collect())
         }
-        let (convex, concave) = (rows::<ENTRIES>(t.vec()?)?, rows::<ENTRIES>(t.vec()?)?);
-        let (convex_exit, concave_exit) = (rows::<EXIT_BINS>(t.vec()?)?, rows::<EXIT_BINS>(t.vec()?)?);
-        let (convex_exit_far, concave_exit_far) = (rows::<EXIT_BINS>(t.vec()?)?, rows::<EXIT_BINS>(t.vec()?)?);
+        fn incidences<const N: usize>(t: &mut super::table_cache::Take) -> Option<[Vec<[f64; N]>; INCIDENCES]> {
+            let rows: Vec<_> = (0..INCIDENCES).map(|_| rows::<N>(t.vec()?)).collect::<Option<_>>()?;
+            rows.try_into().ok()
+        }
+        let (convex, concave) = (incidences::<ENTRIES>(&mut t)?, incidences::<ENTRIES>(&mut t)?);
+        let (convex_exit, concave_exit) = (incidences::<EXIT_BINS>(&mut t)?, incidences::<EXIT_BINS>(&mut t)?);
+        let (convex_exit_far, concave_exit_far) = (incidences::<EXIT_BINS>(&mut t)?, incidences::<EXIT_BINS>(&mut t)?);
         t.end()?;
         Some(CurvatureChannel {
             unit_mm,
@@ -181,12 +226,12 @@ impl super::table_cache::Flat for CurvatureChannel {
 fn flat(unit_mm: f64) -> CurvatureChannel {
     CurvatureChannel {
         unit_mm,
-        convex: vec![[1.0; ENTRIES]; CURVATURE_NODES],
-        concave: vec![[1.0; ENTRIES]; CURVATURE_NODES],
-        convex_exit: vec![[1.0; EXIT_BINS]; CURVATURE_NODES],
-        concave_exit: vec![[1.0; EXIT_BINS]; CURVATURE_NODES],
-        convex_exit_far: vec![[1.0; EXIT_BINS]; CURVATURE_NODES],
-        concave_exit_far: vec![[1.0; EXIT_BINS]; CURVATURE_NODES],
+        convex: std::array::from_fn(|_| vec![[1.0; ENTRIES]; CURVATURE_NODES]),
+        concave: std::array::from_fn(|_| vec![[1.0; ENTRIES]; CURVATURE_NODES]),
+        convex_exit: std::array::from_fn(|_| vec![[1.0; EXIT_BINS]; CURVATURE_NODES]),
+        concave_exit: std::array::from_fn(|_| vec![[1.0; EXIT_BINS]; CURVATURE_NODES]),
+        convex_exit_far: std::array::from_fn(|_| vec![[1.0; EXIT_BINS]; CURVATURE_NODES]),
+        concave_exit_far: std::array::from_fn(|_| vec![[1.0; EXIT_BINS]; CURVATURE_NODES]),
     }
 }
 
@@ -305,8 +350,8 @@ fn measure(m: &Medium, unit_mm: f64) -> CurvatureChannel {
         return flat(unit_mm);
     }
     let albedo = sigma_s / sigma_t;
-    let start = halfspace::entry_direction(m.eta, 1.0);
-    let flat_walk = |photons: Option<u64>, split: Option<&halfspace::Split>| {
+    let flat_walk = |cos_i: f64, photons: Option<u64>, split: Option<&halfspace::Split>| {
+        let start = halfspace::entry_direction(m.eta, cos_i);
         counts(sigma_t, unit_mm, photons, |seed, tally| {
             let seeds = (seed, MAX_COLLISIONS);
             halfspace::trace_slab_split(albedo, m.eta, f64::INFINITY, start, 1, seeds, split, |e| {
@@ -314,81 +359,118 @@ fn measure(m: &Medium, unit_mm: f64) -> CurvatureChannel {
             })
         })
     };
-    // The analogue walk sets how many photons each walk takes and where they split: the far
-    // chords, where it counted a handful, get SPLIT_TARGET (to SPLIT_LEVELS halvings). Then the
-    // half-space and each ball walk those photons, split alike. Without splitting the far
-    // chords, too few to measure, held a nearer entry's ratio where a ball's keeps rising toward
-    // its antipode: a 10 mm Skin1 ball's far rings in green were 0.85-0.99 of its exact walk.
-    let (analogue, photons, analogue_scatterings) = flat_walk(None, None);
+    // The analogue walk at normal incidence sets how many photons each walk takes and where they
+    // split: the far chords, where it counted a handful, get SPLIT_TARGET (to SPLIT_LEVELS
+    // halvings). Then the half-space and each ball walk those photons, split alike, at each
+    // angle of incidence. Without splitting the far chords, too few to measure, held a nearer
+    // entry's ratio where a ball's keeps rising toward its antipode: a 10 mm Skin1 ball's far
+    // rings in green were 0.85-0.99 of its exact walk.
+    let (analogue, photons, analogue_scatterings) = flat_walk(1.0, None, None);
     let levels = split_levels(&totals(&analogue).photons);
     let level = |distance: f64| entry_of(distance / sigma_t, unit_mm).map_or(SPLIT_LEVELS, |i| levels[i]);
     // Each walk's copies may take half the analogue walk's scatterings (Skin1's take less).
     let split = || halfspace::Split { level: &level, allowance: analogue_scatterings.div_ceil(2).into() };
-    let (flat_counts, _, _) = flat_walk(Some(photons), Some(&split()));
-    let split = &split;
+    let (flat_walk, split) = (&flat_walk, &split);
+    let flat_counts: Vec<Counts> = std::thread::scope(|s| {
+        let handles: Vec<_> = (0..INCIDENCES)
+            .map(|j| s.spawn(move || flat_walk(incidence_cos(j), Some(photons), Some(&split())).0))
+            .collect();
+        handles.into_iter().map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e))).collect()
+    });
+    let flat_counts = &flat_counts;
     // The half-space's escapes per entry that the Monte Carlo table's profile gives for as many
-    // photons: where the paired walk counts too few (far from the entry) the ball is read against
-    // the profile the shade pass multiplies the ratio by, so that their product is the ball's.
-    // Taken once the first row has walked: the profile is measured meanwhile on another thread
-    // (gpu_world), and McProfile::of waits for it rather than measure it again.
-    let expected = OnceLock::new();
+    // photons at each angle of incidence: where the paired walk counts too few (far from the
+    // entry) the ball is read against the profile the shade pass multiplies the ratio by, so that
+    // their product is the ball's. Taken once the first row has walked: the profile is measured
+    // meanwhile on another thread (gpu_world), and McProfile::of waits for it rather than measure
+    // it again.
+    let expected: [OnceLock<[f64; ENTRIES]>; INCIDENCES] = Default::default();
     let expected = &expected;
-    // Signed radius in this channel's mean free paths: the node's ratios per entry and per exit bin.
-    let row = |radius: f64| -> ([f64; ENTRIES], ([f64; EXIT_BINS], [f64; EXIT_BINS])) {
+    // Row of incidence `j`, signed radius in this channel's mean free paths: the node's ratios
+    // per entry and (at normal incidence) per exit bin.
+    let row = |j: usize, radius: f64| -> ([f64; ENTRIES], ([f64; EXIT_BINS], [f64; EXIT_BINS])) {
         let split = split();
+        let start = halfspace::entry_direction(m.eta, incidence_cos(j));
         let (curved, _, _) = counts(sigma_t, unit_mm, Some(photons), |seed, tally| {
             sphere::trace_sphere_split(albedo, m.eta, radius, start, 1, (seed, MAX_COLLISIONS), Some(&split), |e| {
                 tally(e.position, e.mu_o2, e.scatterings, e.weight)
             })
         });
         let radius_mm = radius / sigma_t;
-        let expected = expected.get_or_init(|| expected_counts(&McProfile::of(m), photons, unit_mm));
+        let sin2_i = INCIDENCE_SIN2[j];
+        let expected = expected[j].get_or_init(|| {
+            expected_counts_within(&McProfile::of(m), photons, unit_mm, f64::INFINITY, sin2_i, m.eta)
+        });
         // The share of each entry's chords that a ball has (none past its diameter 2R).
         let within = if radius_mm > 0.0 {
-            let within = expected_counts_within(&McProfile::of(m), photons, unit_mm, 2.0 * radius_mm);
+            let within =
+                expected_counts_within(&McProfile::of(m), photons, unit_mm, 2.0 * radius_mm, sin2_i, m.eta);
             std::array::from_fn(|i| if expected[i] > 0.0 { within[i] / expected[i] } else { 1.0 })
         } else {
             [1.0; ENTRIES]
         };
-        (
-            ratios(&totals(&curved), &totals(&flat_counts), expected, &within, radius_mm, unit_mm),
-            (
-                exit_ratios(&curved, &flat_counts, radius_mm, unit_mm, false),
-                exit_ratios(&curved, &flat_counts, radius_mm, unit_mm, true),
-            ),
-        )
+        let flat_counts = &flat_counts[j];
+        let exits = (
+            exit_ratios(&curved, flat_counts, radius_mm, unit_mm, false),
+            exit_ratios(&curved, flat_counts, radius_mm, unit_mm, true),
+        );
+        (ratios(&totals(&curved), &totals(flat_counts), expected, &within, radius_mm, unit_mm), exits)
     };
     let radius_of = |k: usize| unit_mm / node_curvature(k) * sigma_t;
-    // Each node walks on its own thread: the rows are independent and seeded alike whichever
+    // Each row walks on its own thread: the rows are independent and seeded alike whichever
     // thread walks them, so the table is the same bits on any machine, in a sixteenth of the time
     // where there are the cores (20 s to 2-3 s of a `--model mc` start).
     let (row, radius_of) = (&row, &radius_of);
+    let per_incidence = 2 * CURVATURE_NODES;
     let rows: Vec<_> = std::thread::scope(|s| {
-        let handles: Vec<_> = (0..2 * CURVATURE_NODES)
+        let handles: Vec<_> = (0..INCIDENCES * per_incidence)
             .map(|i| {
+                let (j, i) = (i / per_incidence, i % per_incidence);
                 let signed = if i < CURVATURE_NODES { 1.0 } else { -1.0 };
-                s.spawn(move || row(signed * radius_of(i % CURVATURE_NODES)))
+                s.spawn(move || row(j, signed * radius_of(i % CURVATURE_NODES)))
             })
             .collect();
         handles.into_iter().map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e))).collect()
     });
-    let (convex, exits): (Vec<_>, Vec<_>) = rows[..CURVATURE_NODES].iter().cloned().unzip();
-    let (convex_exit, convex_exit_far) = exits.into_iter().unzip();
-    let (concave, exits): (Vec<_>, Vec<_>) = rows[CURVATURE_NODES..].iter().cloned().unzip();
-    let (concave_exit, concave_exit_far) = exits.into_iter().unzip();
-    CurvatureChannel { unit_mm, convex, concave, convex_exit, concave_exit, convex_exit_far, concave_exit_far }
+    let side = |j: usize, concave: bool| {
+        let first = j * per_incidence + if concave { CURVATURE_NODES } else { 0 };
+        &rows[first..first + CURVATURE_NODES]
+    };
+    let ratios_of = |concave: bool| std::array::from_fn(|j| side(j, concave).iter().map(|r| r.0).collect());
+    let exits_of =
+        |concave: bool, far: bool| std::array::from_fn(|j| side(j, concave).iter().map(|r| if far { r.1 .1 } else { r.1 .0 }).collect());
+    CurvatureChannel {
+        unit_mm,
+        convex: ratios_of(false),
+        concave: ratios_of(true),
+        convex_exit: exits_of(false, false),
+        concave_exit: exits_of(true, false),
+        convex_exit_far: exits_of(false, true),
+        concave_exit_far: exits_of(true, true),
+    }
 }
 
 /// The multiply scattered escapes per entry of `photons` entering a half-space by the Monte
 /// Carlo table's profile: photons · ∫ M(r) 2πr dr over the entry's chords (midpoints in u,
 /// 64 per entry; the last entry to u = 1 − 1/(64·ENTRIES)).
+#[cfg(test)]
 fn expected_counts(profile: &McProfile, photons: u64, unit_mm: f64) -> [f64; ENTRIES] {
-    expected_counts_within(profile, photons, unit_mm, f64::INFINITY)
+    expected_counts_within(profile, photons, unit_mm, f64::INFINITY, 0.0, 1.0)
 }
 
-/// The same of the chords shorter than `limit_mm` only.
-fn expected_counts_within(profile: &McProfile, photons: u64, unit_mm: f64, limit_mm: f64) -> [f64; ENTRIES] {
+/// The same of the chords shorter than `limit_mm` only, for a beam at sin²θi = `sin2_i` into a
+/// medium of index `eta`: the profile the shade pass draws there, M(r) f(θt) (1 + a(r) sin²θt).
+fn expected_counts_within(
+    profile: &McProfile,
+    photons: u64,
+    unit_mm: f64,
+    limit_mm: f64,
+    sin2_i: f64,
+    eta: f64,
+) -> [f64; ENTRIES] {
     const STEPS: usize = 64;
+    let sin2_t = sin2_i / (eta * eta);
+    let incidence = if sin2_i > 0.0 { profile.incidence_factor((1.0 - sin2_t).max(0.0).sqrt()) } else { 1.0 };
     std::array::from_fn(|i| {
         (0..STEPS)
             .map(|j| {
@@ -396,7 +478,8 @@ fn expected_counts_within(profile: &McProfile, photons: u64, unit_mm: f64, limit
                 let r = unit_mm * u / (1.0 - u);
                 let dr = unit_mm / ((1.0 - u) * (1.0 - u)) / (ENTRIES * STEPS) as f64;
                 if r < limit_mm {
-                    profile.exitance(r) * 2.0 * std::f64::consts::PI * r * dr
+                    let radial = if sin2_i > 0.0 { (1.0 + profile.radial_at(r) * sin2_t).max(0.0) } else { 1.0 };
+                    incidence * profile.exitance(r) * radial * 2.0 * std::f64::consts::PI * r * dr
                 } else {
                     0.0
                 }
@@ -516,8 +599,10 @@ fn ratios(
 }
 
 impl CurvatureChannel {
-    /// The ratio at chord `r_mm` and curvature `kappa` (1/mm), linear between the measured
-    /// entries (the shade pass's table, gpu::sd_table::CurvatureRatios, is made from it).
+    /// The ratio at chord `r_mm` and curvature `kappa` (1/mm) for light that entered at
+    /// sin²θi = `sin2_i` (outside), linear between the measured entries and between the rows of
+    /// incidence ([`incidence_rows`]; the shade pass's table, gpu::sd_table::CurvatureRatios, is
+    /// made from it).
     ///
     /// Between two nodes each is read at the same chord relative to its own radius, r·κ/κ_k (the
     /// same place on its ball: a 10 mm ball's antipode reads each node's antipode), not at the
@@ -525,7 +610,7 @@ impl CurvatureChannel {
     /// smaller node's antipode leaked into the larger ball's middle chords. Against a walk of the
     /// ball itself between nodes (Skin1, R = 5 mm, κL = 0.74): 2.13 against 2.09 at a 4.75 mm
     /// chord (2.27 read at one chord), 2.61 against 2.65 at 6.25 mm (3.08).
-    pub fn ratio(&self, r_mm: f64, kappa: f64) -> f64 {
+    pub fn ratio(&self, r_mm: f64, kappa: f64, sin2_i: f64) -> f64 {
         if self.unit_mm.is_nan() || self.unit_mm <= 0.0 {
             return 1.0;
         }
@@ -534,16 +619,22 @@ impl CurvatureChannel {
         // row is held, its own (a pair across a box's edge reads a curvature of no ball there,
         // and read at r·κ it took the smallest ball's antipode: 2-10 times the half-space).
         let relative = if kappa.is_nan() { 0.0 } else { r_mm * kappa.abs().min(last_curvature(self.unit_mm)) };
+        let (j, g) = incidence_rows(sin2_i);
         let at = |row: Option<usize>| match row {
             None => 1.0,
-            Some(k) => self.node_ratio(kappa < 0.0, k, relative * self.unit_mm / node_curvature(k)),
+            Some(k) => {
+                let chord = relative * self.unit_mm / node_curvature(k);
+                let (a, b) = (self.node_ratio(kappa < 0.0, j, k, chord), self.node_ratio(kappa < 0.0, j + 1, k, chord));
+                a + (b - a) * g
+            }
         };
         at(a_row) + (at(b_row) - at(a_row)) * f
     }
 
-    /// Node `k`'s ratio (a cavity's where `concave`) at chord `r_mm`, linear between entries.
-    pub fn node_ratio(&self, concave: bool, k: usize, r_mm: f64) -> f64 {
-        let rows = if concave { &self.concave } else { &self.convex };
+    /// Node `k`'s ratio (a cavity's where `concave`) for incidence row `j` at chord `r_mm`,
+    /// linear between entries.
+    pub fn node_ratio(&self, concave: bool, j: usize, k: usize, r_mm: f64) -> f64 {
+        let rows = if concave { &self.concave[j] } else { &self.convex[j] };
         let x = (r_mm / (r_mm + self.unit_mm) * ENTRIES as f64 - 0.5).clamp(0.0, (ENTRIES - 1) as f64);
         if x.is_nan() {
             return 1.0;
@@ -563,14 +654,23 @@ impl CurvatureChannel {
     /// (1/mm): linear in cos²θo between the bins' centres (held beyond the outer ones, as the
     /// table's exit factor h), and between nodes as [`CurvatureChannel::ratio`].
     /// `far`: the share of the light that came from beyond a chord R√2, whose rows it weighs.
-    pub fn exit_ratio(&self, cos_o: f64, kappa: f64, far: f64) -> f64 {
+    /// `sin2_i`: the light's mean sin²θi where it entered (weighted by what each entry sends the
+    /// pixel), linear between the rows of incidence as [`CurvatureChannel::ratio`].
+    pub fn exit_ratio(&self, cos_o: f64, kappa: f64, far: f64, sin2_i: f64) -> f64 {
         if self.unit_mm.is_nan() || self.unit_mm <= 0.0 {
             return 1.0;
         }
-        let near = self.exit_ratio_of(if kappa < 0.0 { &self.concave_exit } else { &self.convex_exit }, cos_o, kappa);
-        let beyond =
-            self.exit_ratio_of(if kappa < 0.0 { &self.concave_exit_far } else { &self.convex_exit_far }, cos_o, kappa);
-        near + (beyond - near) * far
+        let (j, g) = incidence_rows(sin2_i);
+        let at = |j: usize| {
+            let (near_rows, far_rows) = if kappa < 0.0 {
+                (&self.concave_exit[j], &self.concave_exit_far[j])
+            } else {
+                (&self.convex_exit[j], &self.convex_exit_far[j])
+            };
+            let (near, beyond) = (self.exit_ratio_of(near_rows, cos_o, kappa), self.exit_ratio_of(far_rows, cos_o, kappa));
+            near + (beyond - near) * far
+        };
+        at(j) + (at(j + 1) - at(j)) * g
     }
 
     fn exit_ratio_of(&self, rows: &[[f64; EXIT_BINS]], cos_o: f64, kappa: f64) -> f64 {
@@ -659,18 +759,26 @@ mod tests {
         for k in 0..CURVATURE_NODES {
             eprintln!(
                 "convex {k}: {:?}",
-                &c.convex[k].iter().step_by(4).map(|v| (v * 100.0).round() / 100.0).collect::<Vec<_>>()
+                &c.convex[0][k].iter().step_by(4).map(|v| (v * 100.0).round() / 100.0).collect::<Vec<_>>()
             );
             eprintln!(
                 "concave {k}: {:?}",
-                &c.concave[k].iter().step_by(4).map(|v| (v * 100.0).round() / 100.0).collect::<Vec<_>>()
+                &c.concave[0][k].iter().step_by(4).map(|v| (v * 100.0).round() / 100.0).collect::<Vec<_>>()
             );
         }
         for k in 0..CURVATURE_NODES {
-            eprintln!("convex exit {k}: {:?}", c.convex_exit[k].map(|v| (v * 1000.0).round() / 1000.0));
-            eprintln!("concave exit {k}: {:?}", c.concave_exit[k].map(|v| (v * 1000.0).round() / 1000.0));
+            eprintln!("convex exit {k}: {:?}", c.convex_exit[0][k].map(|v| (v * 1000.0).round() / 1000.0));
+            eprintln!("concave exit {k}: {:?}", c.concave_exit[0][k].map(|v| (v * 1000.0).round() / 1000.0));
         }
-        assert!(c.ratio(unit, 1.0 / unit) > 1.05);
-        assert!(c.ratio(unit, -1.0 / unit) < 0.98);
+        for k in 0..CURVATURE_NODES {
+            eprintln!(
+                "convex {k} at cos θi 0.2: {:?}",
+                &c.convex[INCIDENCES - 1][k].iter().step_by(4).map(|v| (v * 100.0).round() / 100.0).collect::<Vec<_>>()
+            );
+        }
+        for sin2_i in INCIDENCE_SIN2 {
+            assert!(c.ratio(unit, 1.0 / unit, sin2_i) > 1.05);
+            assert!(c.ratio(unit, -1.0 / unit, sin2_i) < 0.98);
+        }
     }
 }
