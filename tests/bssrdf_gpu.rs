@@ -236,7 +236,15 @@ fn gpu_curvature_terms_match_cpu() {
         }
         let [c, g] = ratios.exit_tilt_at(r);
         let [b2, b3] = ratios.harmonics_at(r);
-        let cpu = [ratios.lookup(r, kappa, sin2_i), ratios.lookup_exit(cos_o, kappa, far, q[1][3] as f64), c, g, b2, b3, ratios.radial_at(r)];
+        let cpu = [
+            ratios.lookup(r, kappa, sin2_i),
+            ratios.lookup_exit(cos_o, kappa, far, q[1][3] as f64),
+            c,
+            g,
+            b2,
+            b3,
+            ratios.radial_at(r),
+        ];
         for (k, expected) in cpu.iter().enumerate() {
             for ch in 0..3 {
                 let gpu = results[TERMS * i + k][ch] as f64;

@@ -100,7 +100,8 @@ fn a_ball_returns_more_a_cavity_less_and_flat_is_one() {
             assert!(grazing < 1.0 && normal > 1.0 && normal - grazing > 0.05, "channel {c}: {grazing} / {normal}");
         }
         // The light from the far side of the ball leaves still nearer the normal.
-        let (far_grazing, far_normal) = (ch.exit_ratio(0.2, 1.0 / unit, 1.0, 0.0), ch.exit_ratio(1.0, 1.0 / unit, 1.0, 0.0));
+        let (far_grazing, far_normal) =
+            (ch.exit_ratio(0.2, 1.0 / unit, 1.0, 0.0), ch.exit_ratio(1.0, 1.0 / unit, 1.0, 0.0));
         println!("channel {c}: the far light's at κL = 1, cos θo 0.2 / 1: {far_grazing:.3} / {far_normal:.3}");
         if c < 2 {
             assert!(far_grazing < grazing && far_normal > normal, "channel {c}: {far_grazing} / {far_normal}");
@@ -138,7 +139,10 @@ fn the_gpu_table_reads_the_ratios() {
                     let exact = channels[c].ratio(r, kappa, sin2_i);
                     let d = (gpu[c] / exact - 1.0).abs();
                     if d > 0.01 {
-                        println!("κL {kappa_l} r/L {r_l} sin²θi {sin2_i} channel {c}: table {:.4} ratio {exact:.4}", gpu[c]);
+                        println!(
+                            "κL {kappa_l} r/L {r_l} sin²θi {sin2_i} channel {c}: table {:.4} ratio {exact:.4}",
+                            gpu[c]
+                        );
                     }
                     worst = worst.max(d);
                 }
@@ -196,12 +200,20 @@ fn chord_rings(m: &Medium, r_mm: f64, cos_i: f64, seed: u64, rings: usize, photo
     let mut counts = vec![0u64; rings];
     let start = halfspace::entry_direction(m.eta, cos_i);
     for p in 0..photons {
-        sphere::trace_sphere(albedo, m.eta, radius, start, 1, (seed ^ p.wrapping_mul(0x9E37_79B9_7F4A_7C15), 100_000), |e| {
-            let k = (e.position.length() / (2.0 * radius) * rings as f64) as usize;
-            if e.scatterings >= 2 && k < rings {
-                counts[k] += 1;
-            }
-        });
+        sphere::trace_sphere(
+            albedo,
+            m.eta,
+            radius,
+            start,
+            1,
+            (seed ^ p.wrapping_mul(0x9E37_79B9_7F4A_7C15), 100_000),
+            |e| {
+                let k = (e.position.length() / (2.0 * radius) * rings as f64) as usize;
+                if e.scatterings >= 2 && k < rings {
+                    counts[k] += 1;
+                }
+            },
+        );
     }
     counts
 }
@@ -377,7 +389,8 @@ fn the_front_lit_sphere_at_its_pole_matches_the_walk() {
                 * (PI / 2.0 / steps as f64);
             flat += weight * profile.exitance(chord);
             let lean = profile.lean(chord, -sin_t, sin_t * sin_t);
-            curved += weight * profile.exitance(chord) * lean * curvature[c].ratio(chord, 1.0 / r_mm, 1.0 - cos_i * cos_i);
+            curved +=
+                weight * profile.exitance(chord) * lean * curvature[c].ratio(chord, 1.0 / r_mm, 1.0 - cos_i * cos_i);
         }
         println!(
             "channel {c}: walk {truth:.5} ± {:.1}%, flat half-space {:.3}, curved model {:.3}",

@@ -114,8 +114,11 @@ fn model_rings(m: &Medium, ratios: &CurvatureChannel, r_mm: f64, toward: f64, ti
                     };
                     let lean = profile.lean(chord, sin_t * cos_phi, sin_t * sin_t);
                     let kappa = curvature_profile::pair_curvature(d, n, no).unwrap_or(1.0 / r_mm);
-                    let mut v =
-                        w * profile.incidence_factor(cos_t) * profile.sd(chord) * lean * ratios.ratio(chord, kappa, 1.0 - cos_i * cos_i);
+                    let mut v = w
+                        * profile.incidence_factor(cos_t)
+                        * profile.sd(chord)
+                        * lean
+                        * ratios.ratio(chord, kappa, 1.0 - cos_i * cos_i);
                     let away = d - d.dot(no) * no;
                     if tilt && away.length() > 1e-12 {
                         let [c, g] = profile.exit_tilt_at(chord);

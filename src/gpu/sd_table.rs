@@ -489,7 +489,9 @@ impl CurvatureRatios {
                 .collect()
         };
         let ratios = (0..curvature_profile::INCIDENCES).flat_map(|j| {
-            side(&self.convex[j], CURVATURE_TABLE_ENTRIES).into_iter().chain(side(&self.concave[j], CURVATURE_TABLE_ENTRIES))
+            side(&self.convex[j], CURVATURE_TABLE_ENTRIES)
+                .into_iter()
+                .chain(side(&self.concave[j], CURVATURE_TABLE_ENTRIES))
         });
         header
             .chain(ratios)

@@ -187,9 +187,8 @@ impl super::table_cache::Flat for CurvatureChannel {
         for rows in self.convex.iter().chain(&self.concave) {
             super::table_cache::push_vec(&mut v, rows.iter().flatten().copied().collect::<Vec<_>>().into_iter());
         }
-        for rows in [&self.convex_exit, &self.concave_exit, &self.convex_exit_far, &self.concave_exit_far]
-            .into_iter()
-            .flatten()
+        for rows in
+            [&self.convex_exit, &self.concave_exit, &self.convex_exit_far, &self.concave_exit_far].into_iter().flatten()
         {
             super::table_cache::push_vec(&mut v, rows.iter().flatten().copied().collect::<Vec<_>>().into_iter());
         }
@@ -398,13 +397,11 @@ fn measure(m: &Medium, unit_mm: f64) -> CurvatureChannel {
         });
         let radius_mm = radius / sigma_t;
         let sin2_i = INCIDENCE_SIN2[j];
-        let expected = expected[j].get_or_init(|| {
-            expected_counts_within(&McProfile::of(m), photons, unit_mm, f64::INFINITY, sin2_i, m.eta)
-        });
+        let expected = expected[j]
+            .get_or_init(|| expected_counts_within(&McProfile::of(m), photons, unit_mm, f64::INFINITY, sin2_i, m.eta));
         // The share of each entry's chords that a ball has (none past its diameter 2R).
         let within = if radius_mm > 0.0 {
-            let within =
-                expected_counts_within(&McProfile::of(m), photons, unit_mm, 2.0 * radius_mm, sin2_i, m.eta);
+            let within = expected_counts_within(&McProfile::of(m), photons, unit_mm, 2.0 * radius_mm, sin2_i, m.eta);
             std::array::from_fn(|i| if expected[i] > 0.0 { within[i] / expected[i] } else { 1.0 })
         } else {
             [1.0; ENTRIES]
@@ -437,8 +434,9 @@ fn measure(m: &Medium, unit_mm: f64) -> CurvatureChannel {
         &rows[first..first + CURVATURE_NODES]
     };
     let ratios_of = |concave: bool| std::array::from_fn(|j| side(j, concave).iter().map(|r| r.0).collect());
-    let exits_of =
-        |concave: bool, far: bool| std::array::from_fn(|j| side(j, concave).iter().map(|r| if far { r.1 .1 } else { r.1 .0 }).collect());
+    let exits_of = |concave: bool, far: bool| {
+        std::array::from_fn(|j| side(j, concave).iter().map(|r| if far { r.1 .1 } else { r.1 .0 }).collect())
+    };
     CurvatureChannel {
         unit_mm,
         convex: ratios_of(false),
@@ -667,7 +665,8 @@ impl CurvatureChannel {
             } else {
                 (&self.convex_exit[j], &self.convex_exit_far[j])
             };
-            let (near, beyond) = (self.exit_ratio_of(near_rows, cos_o, kappa), self.exit_ratio_of(far_rows, cos_o, kappa));
+            let (near, beyond) =
+                (self.exit_ratio_of(near_rows, cos_o, kappa), self.exit_ratio_of(far_rows, cos_o, kappa));
             near + (beyond - near) * far
         };
         at(j) + (at(j + 1) - at(j)) * g
