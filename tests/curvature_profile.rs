@@ -255,13 +255,7 @@ fn between_nodes_the_ratio_reads_each_ball_at_the_same_place() {
             let ratio = drawn / (count as f64 / photons as f64);
             line += &format!(" {ratio:.3}");
             if count >= 400 {
-                // Ring 0 (chords under 0.5 mm) is the half-space's oblique profile near its entry
-                // (1.06 in red with either rows: the ball is flat there).
-                let bound = match k {
-                    0 => 0.08,
-                    _ if k < 11 => 0.05,
-                    _ => 0.10,
-                };
+                let bound = if k < 11 { 0.05 } else { 0.10 };
                 measured.push((k, ratio, bound));
             }
         }
