@@ -218,6 +218,19 @@ fn chord_rings(m: &Medium, r_mm: f64, cos_i: f64, seed: u64, rings: usize, photo
     counts
 }
 
+/// ∫ `exitance(r)` 2πr dr over chord ring `k` of `rings` over a ball's diameter 2·`r_mm`
+/// (midpoints, 200 steps): what [`chord_rings`] counts, per photon.
+fn ring_integral(k: usize, rings: usize, r_mm: f64, exitance: impl Fn(f64) -> f64) -> f64 {
+    let (c0, c1) = (k as f64 / rings as f64 * 2.0 * r_mm, (k + 1) as f64 / rings as f64 * 2.0 * r_mm);
+    let steps = 200;
+    (0..steps)
+        .map(|j| {
+            let r = c0 + (j as f64 + 0.5) / steps as f64 * (c1 - c0);
+            exitance(r) * 2.0 * PI * r * (c1 - c0) / steps as f64
+        })
+        .sum()
+}
+
 /// A ball between two curvature nodes (Skin1, R = 5 mm: κL = 0.74, between nodes 0.5 and 1),
 /// walked itself: its multiply scattered exitance per chord ring (0.5 mm) against what the shade
 /// pass draws, the Monte Carlo table's profile times the ratio read between the nodes. Each node
@@ -244,14 +257,7 @@ fn between_nodes_the_ratio_reads_each_ball_at_the_same_place() {
         let mut line = format!("channel {c}, table / walk per ring:");
         let mut measured = Vec::new();
         for (k, &count) in counts.iter().enumerate() {
-            let (c0, c1) = (k as f64 / rings as f64 * 2.0 * r_mm, (k + 1) as f64 / rings as f64 * 2.0 * r_mm);
-            let steps = 200;
-            let drawn: f64 = (0..steps)
-                .map(|j| {
-                    let r = c0 + (j as f64 + 0.5) / steps as f64 * (c1 - c0);
-                    profile.exitance(r) * ratios[c].ratio(r, 1.0 / r_mm, 0.0) * 2.0 * PI * r * (c1 - c0) / steps as f64
-                })
-                .sum();
+            let drawn = ring_integral(k, rings, r_mm, |r| profile.exitance(r) * ratios[c].ratio(r, 1.0 / r_mm, 0.0));
             let ratio = drawn / (count as f64 / photons as f64);
             line += &format!(" {ratio:.3}");
             if count >= 400 {
@@ -288,22 +294,12 @@ fn an_oblique_beam_on_a_ball_reads_the_rows_of_its_incidence() {
         let sin2_t = sin2_i / (m.eta * m.eta);
         let incidence = profile.incidence_factor((1.0 - sin2_t).sqrt());
         let drawn = |k: usize, sin2: f64| -> f64 {
-            let (c0, c1) = (k as f64 / rings as f64 * 2.0 * r_mm, (k + 1) as f64 / rings as f64 * 2.0 * r_mm);
-            let steps = 200;
-            (0..steps)
-                .map(|j| {
-                    let r = c0 + (j as f64 + 0.5) / steps as f64 * (c1 - c0);
-                    incidence
-                        * profile.exitance(r)
-                        * (1.0 + profile.radial_at(r) * sin2_t).max(0.0)
-                        * ratios[c].ratio(r, 1.0 / r_mm, sin2)
-                        * 2.0
-                        * PI
-                        * r
-                        * (c1 - c0)
-                        / steps as f64
-                })
-                .sum()
+            ring_integral(k, rings, r_mm, |r| {
+                incidence
+                    * profile.exitance(r)
+                    * (1.0 + profile.radial_at(r) * sin2_t).max(0.0)
+                    * ratios[c].ratio(r, 1.0 / r_mm, sin2)
+            })
         };
         let (mut line, mut normal_line) = (format!("channel {c}, table / walk per ring:"), String::new());
         let (mut normal_worst, mut measured) = (0.0f64, Vec::new());
