@@ -325,6 +325,55 @@ fn a_far_point_light_against_the_path_tracer() {
     }
 }
 
+/// Objects that are not convex against the path tracer's light along the one route every model
+/// here draws: in at the pixel's point, through the medium, out once and straight to the light
+/// (`scripts/reference --routes`, scripts/mitsuba_routes.py; recorded as `*-one-exit`). The rest
+/// of the path tracer's light left the object and entered it again, or is the object's light
+/// seen in the boundary's reflection at the pixel: 14 / 13 / 12% of the default Skin1 bunny's
+/// (R / G / B), 15 / 16 / 15% of Marble's, 5 / 3 / 2% of the back-lit torus's, none of a
+/// sphere's. Against all the light mc reads 1.008 0.909 0.874 on the Skin1 bunny; against its
+/// own route it is 1.187 1.061 0.996, Marble's 1.203 1.175 1.121, the torus 1.110 1.058 1.042:
+/// too bright, where the whole reference had called the bunny too dark (README, "Routes no BSSRDF
+/// draws"). Each held to its recorded ratio within 4%, as the other curved objects are; and the
+/// split's total must agree with `volpathmis`' reference of the same scene (the split is the
+/// same light, counted by route) within three of their combined standard errors.
+#[test]
+fn the_models_route_against_the_path_tracer() {
+    let cases: [(&str, &str, &[&str]); 3] = [
+        ("skin1/bunny-one-exit", "skin1/bunny", &[]),
+        ("marble/bunny-one-exit", "marble/bunny", &[]),
+        ("skin1/torus-back-one-exit", "skin1/torus-back", &["--brute-force", "--samples", "100000"]),
+    ];
+    let numbers =
+        |v: &serde_json::Value| -> Vec<f64> { v.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect() };
+    for (name, whole, sampling) in cases {
+        let c = case(name);
+        let all = numbers(&c["routes"]["all"]["object_mean"]);
+        let all_noise = numbers(&c["routes"]["all"]["relative_noise_of_mean"]);
+        let reference = case(whole);
+        let volpath = numbers(&reference["path_traced_mean"]);
+        let volpath_noise = numbers(&reference["relative_noise_of_mean"]);
+        for ch in 0..3 {
+            let off = all[ch] / volpath[ch] - 1.0;
+            let sigma = (all_noise[ch].powi(2) + volpath_noise[ch].powi(2)).sqrt();
+            println!(
+                "{name} channel {ch}: the routes' total / volpathmis = {:.4} (combined noise {:.2}%)",
+                1.0 + off,
+                100.0 * sigma
+            );
+            assert!(off.abs() < 3.0 * sigma, "{name} channel {ch}: the split's total is {off:+.4} off volpathmis'");
+        }
+        let measured = recorded_mc_ratio(name);
+        for (ch, ratio) in mc_against_its_reference(name, sampling).into_iter().enumerate() {
+            println!(
+                "{name} mc channel {ch}: translucent / the route it draws = {ratio:.4} (recorded {:.4})",
+                measured[ch]
+            );
+            assert!((ratio / measured[ch] - 1.0).abs() < 0.04, "{name} channel {ch}: {ratio} against {}", measured[ch]);
+        }
+    }
+}
+
 /// The Monte Carlo table's ratio to the path tracer recorded for case `name`, per channel.
 fn recorded_mc_ratio(name: &str) -> Vec<f64> {
     case(name)["ratio_translucent_over_path_traced"]["mc"]
