@@ -69,8 +69,9 @@ def main():
             split = np.array(
                 mi.render(scene, integrator=mi.load_dict({"type": "route_split"}), seed=seed, spp=a.spp), dtype=np.float64
             )
-            # RGBA (the one-exit route), then reenters, seen_in_reflection, one_exit_single (RGB each).
-            per_route = [split[..., 0:3]] + [split[..., 4 + 3 * k:7 + 3 * k] for k in range(3)]
+            # RGBA (the one-exit route), then the other routes (RGB each).
+            others = len(mitsuba_routes.ROUTES) - 1
+            per_route = [split[..., 0:3]] + [split[..., 4 + 3 * k:7 + 3 * k] for k in range(others)]
             routes.append(per_route)
             full = split[..., 0:4].copy()
             full[..., :3] = per_route[0] + per_route[1] + per_route[2]
