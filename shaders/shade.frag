@@ -870,8 +870,10 @@ void main() {
             * curvature_exit(dipole_table, pixel_curvature_rows, cos_o, far, sin2_i);
         if (across_thickness.y > 0.0) {
             float t = across_thickness.x / across_thickness.y;
+            vec3 sin2_t = across_incidence / across_thickness.y;
             lo += fresnel_transmittance(object_params.channels[0].eta, cos_o) * across_sum
-                * slab_exit_factor(dipole_table, slab_header, t, cos_o);
+                * slab_exit_factor(dipole_table, slab_header, t, cos_o)
+                * slab_oblique_factor(dipole_table, slab_header, t, sin2_t, object_params.channels[0].eta);
         } else {
             lo += fresnel_transmittance(object_params.channels[0].eta, cos_o) * across_sum;
         }

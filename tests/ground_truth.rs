@@ -57,6 +57,17 @@ fn skin1_thin_slab_against_the_path_tracer() {
 /// and 0.020), the rest light scattered more that the slab table carries across. Within 5% (the
 /// path tracer's noise of its mean 0.8 / 1.7 / 1.7%); measured 0.989 1.026 0.986 (0.937 in
 /// green when the table's measurement ended at its first node, tests/slab_profile.rs).
+/// The same slab lit from behind at 60° (refracted in at θt = 42°): its light across read with the
+/// slab's change of what it lets through with incidence (src/physics/slab_profile.rs,
+/// `oblique_factor`): 1.021 1.056 1.072 of the path tracer (noise of its mean 0.2–0.3%), within
+/// 8%; read at normal incidence it was 0.944 1.029 1.135. Green and blue are still over; its
+/// multiple scattering alone is 1.03 1.07 1.10 of the path tracer's (README, "Oblique light
+/// across a slab").
+#[test]
+fn skin1_thin_slab_lit_at_60_degrees_against_the_path_tracer() {
+    against_the_path_tracer("skin1/thin-slab-60", "skin1-thin-slab-60", &["mc"], 0.08);
+}
+
 #[test]
 fn ketchup_thin_slab_against_the_path_tracer() {
     against_the_path_tracer("ketchup/thin-slab", "ketchup-thin-slab", &["mc"], 0.05);
@@ -204,12 +215,12 @@ fn curved_objects_against_the_path_tracer() {
     let cases: [(&str, &[&str], [f64; 3]); 12] = [
         ("skin1/sphere-front", &brute, [0.997, 0.996, 0.997]),
         ("skin1/sphere-back", &brute, [1.006, 0.999, 0.993]),
-        ("skin1/box-back", &brute, [1.133, 1.039, 0.975]),
-        ("skin1/lens-back", &brute, [1.039, 1.034, 1.027]),
+        ("skin1/box-back", &brute, [1.120, 1.035, 0.975]),
+        ("skin1/lens-back", &brute, [1.073, 1.048, 1.011]),
         ("skin1/torus-front", &brute, [0.999, 0.994, 1.005]),
-        ("skin1/torus-back", &brute, [1.037, 1.012, 1.005]),
-        ("skin1/bunny", &[], [0.982, 0.878, 0.845]),
-        ("marble/bunny", &[], [1.008, 0.982, 0.945]),
+        ("skin1/torus-back", &brute, [1.036, 1.011, 1.004]),
+        ("skin1/bunny", &[], [0.981, 0.881, 0.848]),
+        ("marble/bunny", &[], [1.007, 0.981, 0.943]),
         ("potato/sphere-front", &[], [1.017, 1.016, 0.996]),
         ("marble/sphere-front", &[], [1.013, 1.007, 1.003]),
         ("potato/sphere-back", &[], [0.995, 1.004, 1.021]),

@@ -157,6 +157,33 @@ vec3 slab_exit_factor(usamplerBuffer table, vec4 header, float t, float cos_o) {
     vec3 h0 = a0 + (b0 - a0) * (y - j), h1 = a1 + (b1 - a1) * (y - j);
     return h0 + (h1 - h0) * a;
 }
+// The transmitted fraction's change with incidence per channel (mirrors
+// SlabChannel::oblique_factor): light refracted in at sin²θt = `sin2_t` (per channel) through
+// thickness t (mm); rows q at sin²θt = q/(SLAB_OBLIQUE_ROWS − 1) of 1/η² (1 where η < 1),
+// linear between rows and between nodes.
+vec3 slab_oblique_factor(usamplerBuffer table, vec4 header, float t, vec3 sin2_t, float eta) {
+    float unit_mm = header.x;
+    float tt = max(t / unit_mm, slab_node_thickness(0.0));
+    float last = float(SLAB_THICKNESS_NODES - 1u);
+    float x = clamp(2.0 * (log2(tt) - SLAB_FIRST_LOG2), 0.0, last);
+    float k = min(floor(x), last - 1.0);
+    float t0 = slab_node_thickness(k), t1 = slab_node_thickness(k + 1.0);
+    float a = clamp((tt - t0) / (t1 - t0), 0.0, 1.0);
+    float row_sin2 = (eta > 1.0 ? 1.0 / (eta * eta) : 1.0) / float(SLAB_OBLIQUE_ROWS - 1u);
+    int base = SLAB_BASE + 1 + int(SLAB_LOOKUP_NODES * SLAB_ENTRIES + SLAB_THICKNESS_NODES * MC_EXIT_BINS)
+             + int(k) * int(SLAB_OBLIQUE_ROWS);
+    vec3 factor;
+    for (int c = 0; c < 3; ++c) {
+        float y = clamp(sin2_t[c] / row_sin2, 0.0, float(SLAB_OBLIQUE_ROWS - 1u));
+        float q = min(floor(y), float(SLAB_OBLIQUE_ROWS - 2u));
+        int row = base + int(q);
+        float f0 = mix(uintBitsToFloat(texelFetch(table, row)[c]), uintBitsToFloat(texelFetch(table, row + 1)[c]), y - q);
+        int next = row + int(SLAB_OBLIQUE_ROWS);
+        float f1 = mix(uintBitsToFloat(texelFetch(table, next)[c]), uintBitsToFloat(texelFetch(table, next + 1)[c]), y - q);
+        factor[c] = mix(f0, f1, a);
+    }
+    return factor;
+}
 
 // The Monte Carlo table's curvature ratios (mirrors gpu::sd_table::CurvatureRatios::lookup,
 // physics::curvature_profile::CurvatureChannel::ratio): C(r; κ), a sphere's (κ = 1/R > 0) or a
@@ -172,7 +199,8 @@ vec3 slab_exit_factor(usamplerBuffer table, vec4 header, float t, float cos_o) {
 // x = −1: no ratios).
 // `curvature_ratio` (per pair): the nearest entry of the two rows of incidence around the pair's
 // sin²θi (two fetches), linear in sin²θi between them per channel, held past the last.
-const int CURVATURE_BASE = SLAB_BASE + 1 + int(SLAB_LOOKUP_NODES * SLAB_ENTRIES + SLAB_THICKNESS_NODES * MC_EXIT_BINS);
+const int CURVATURE_BASE = SLAB_BASE + 1 + int(SLAB_LOOKUP_NODES * SLAB_ENTRIES + SLAB_THICKNESS_NODES * MC_EXIT_BINS)
+                         + int(SLAB_THICKNESS_NODES * SLAB_OBLIQUE_ROWS);
 const float CURVATURE_FIRST_LOG2 = float(CURVATURE_FIRST_LOG2_PLUS_8) - 8.0;
 vec4 curvature_rows_at(float unit_mm, float kappa);
 vec4 curvature_rows(usamplerBuffer table, float kappa) {

@@ -127,11 +127,14 @@ const float SIGMA_DIRECTIONS_REACH = 2.0;
 // normal faces away from the pixel's (w = −ni·no > 0) and lies behind the pixel's tangent plane
 // is read as across a flat slab of thickness t = (xo − xi)·no, at lateral distance ρ, in
 // S = (1 − w) Sp(r) + w T(ρ; t): this returns (1 − w) times the half-space's `sd` and adds
-// w T · `power_mm` to across_sum, and its luminance-weighted thickness to across_thickness (the
-// exit factor h_T is read once per pixel at their mean, main()).
+// w T · `power_mm` to across_sum, and its luminance-weighted thickness to across_thickness and
+// sin²θt of the light refracted in at xi (`sin2_t`, per channel) to across_incidence (the exit
+// factor h_T and the change of what a slab lets through with incidence are read once per
+// pixel at their means, main()).
 vec3 across_sum = vec3(0.0);
 vec2 across_thickness = vec2(0.0); // Σ t·luminance, Σ luminance
-vec3 across(vec3 xi, vec3 ni, vec3 xo, vec3 no, vec3 sd, vec3 power_mm) {
+vec3 across_incidence = vec3(0.0); // Σ sin²θt·luminance per channel
+vec3 across(vec3 xi, vec3 ni, vec3 xo, vec3 no, vec3 sd, vec3 power_mm, vec3 sin2_t) {
     float w = -dot(ni, no);
     if (w <= 0.0) return sd;
     float s = object_params.mm_per_unit;
@@ -149,7 +152,15 @@ vec3 across(vec3 xi, vec3 ni, vec3 xo, vec3 no, vec3 sd, vec3 power_mm) {
     across_sum += through;
     float luminance = dot(through, LUMINANCE);
     across_thickness += vec2(t * luminance, luminance);
+    across_incidence += sin2_t * luminance;
     return (1.0 - w) * sd;
+}
+
+// sin²θt per channel of light from the mean directions `toward[c]` refracted in at a source of
+// normal ni: |toward's part along the surface|²/η² (shorter where the lights' directions differ).
+vec3 refracted_sin2(vec3 toward[3], vec3 ni) {
+    float eta = object_params.channels[0].eta;
+    return vec3(entry_sin2(toward[0], ni), entry_sin2(toward[1], ni), entry_sin2(toward[2], ni)) / (eta * eta);
 }
 
 vec3 source(vec3 xi, vec3 ni, vec3 wi, vec3 power, vec3 xo, vec3 no) {
@@ -167,7 +178,7 @@ vec3 source(vec3 xi, vec3 ni, vec3 wi, vec3 power, vec3 xo, vec3 no) {
         vec3 toward[3] = vec3[](wi, wi, wi);
         vec3 d = (xo - xi) * s;
         float kappa = pair_curvature(d, ni, no);
-        sd = across(xi, ni, xo, no, mc_sd(d, ni, kappa, toward), power * (s * s));
+        sd = across(xi, ni, xo, no, mc_sd(d, ni, kappa, toward), power * (s * s), refracted_sin2(toward, ni));
         count_far(length(d) * kappa, sd * power * (s * s), entry_sin2(wi, ni));
     } else {
         sd = dipole_sd_table(dipole_table, dipole_header, length(xo - xi) * s);
@@ -204,7 +215,7 @@ vec3 merged_source(vec3 xi, vec3 ni, vec3 power, vec4 incident[3], vec3 dw, vec3
         vec3 d = (xo - xi) * s;
         sd = mc_sd(d, ni, kappa, toward);
         if (across_object) {
-            sd = across(xi, ni, xo, no, sd, power * (s * s));
+            sd = across(xi, ni, xo, no, sd, power * (s * s), refracted_sin2(toward, ni));
             count_far(length(d) * kappa, sd * power * (s * s), entry_sin2(toward[1], ni));
         }
     } else {

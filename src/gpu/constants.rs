@@ -17,12 +17,13 @@ pub const MODEL_MC: u32 = 3;
 pub const MC_INCIDENCE_NODES: u32 = 8;
 pub const MC_EXIT_BINS: u32 = 10;
 /// The Monte Carlo table's light across an object (src/physics/slab_profile.rs's
-/// THICKNESS_NODES, LOOKUP_NODES, ENTRIES and FIRST_NODE_LOG2 + 8, checked equal in
+/// THICKNESS_NODES, LOOKUP_NODES, ENTRIES, OBLIQUE_ROWS and FIRST_NODE_LOG2 + 8, checked equal in
 /// gpu::sd_table): measured and lookup thickness nodes, radial entries per node, and the first
-/// node's log2 thickness plus 8 in units of L.
+/// node's log2 thickness plus 8 in units of L; rows of incidence per node.
 pub const SLAB_THICKNESS_NODES: u32 = 22;
 pub const SLAB_LOOKUP_NODES: u32 = 43;
 pub const SLAB_ENTRIES: u32 = 64;
+pub const SLAB_OBLIQUE_ROWS: u32 = 6;
 pub const SLAB_FIRST_NODE_LOG2_PLUS_8: u32 = 4;
 
 /// The Monte Carlo table's curvature ratios (src/physics/curvature_profile.rs's CURVATURE_NODES
@@ -83,6 +84,7 @@ pub const GLSL_CONSTANTS: &[(&str, u32)] = &[
     ("SLAB_THICKNESS_NODES", SLAB_THICKNESS_NODES),
     ("SLAB_LOOKUP_NODES", SLAB_LOOKUP_NODES),
     ("SLAB_ENTRIES", SLAB_ENTRIES),
+    ("SLAB_OBLIQUE_ROWS", SLAB_OBLIQUE_ROWS),
     ("SLAB_FIRST_NODE_LOG2_PLUS_8", SLAB_FIRST_NODE_LOG2_PLUS_8),
     ("CURVATURE_NODES", CURVATURE_NODES),
     ("CURVATURE_TABLE_ENTRIES", CURVATURE_TABLE_ENTRIES),

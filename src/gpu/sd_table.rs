@@ -219,13 +219,15 @@ const _: () = assert!(slab_profile::THICKNESS_NODES == super::SLAB_THICKNESS_NOD
 const _: () = assert!(slab_profile::LOOKUP_NODES == super::SLAB_LOOKUP_NODES as usize);
 const _: () = assert!(slab_profile::ENTRIES == super::SLAB_ENTRIES as usize);
 const _: () = assert!(slab_profile::FIRST_NODE_LOG2 + 8 == super::SLAB_FIRST_NODE_LOG2_PLUS_8 as i32);
+const _: () = assert!(slab_profile::OBLIQUE_ROWS == super::SLAB_OBLIQUE_ROWS as usize);
 
 /// The Monte Carlo table's light across an object, after the angular factors in the same buffer
 /// (bssrdf.glsl's `slab_transmission`, `slab_exit_factor`; [`SlabChannel`]): a header texel (L in
 /// mm, then the channels' scales; L = 0 for the other models, which never read the rest), then
 /// per lookup node its ENTRIES texels, texel i holding entries i and i + 1 of T·reach² / scale
 /// per channel as two f16 (as [`SdTable`]: one fetch per node), then per measured node its
-/// EXIT_BINS exit factors h_T (f32 bits).
+/// EXIT_BINS exit factors h_T (f32 bits), then per measured node its OBLIQUE_ROWS factors of
+/// incidence (f32 bits; `slab_oblique_factor`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct SlabTransmission {
     pub unit_mm: f32,
@@ -235,6 +237,8 @@ pub struct SlabTransmission {
     pub values: Vec<[[u16; 3]; slab_profile::ENTRIES]>,
     /// Per measured node, per exit bin.
     pub exit: Vec<[[f32; 3]; slab_profile::EXIT_BINS]>,
+    /// Per measured node, per row of incidence.
+    pub oblique: Vec<[[f32; 3]; slab_profile::OBLIQUE_ROWS]>,
 }
 
 impl SlabTransmission {
@@ -245,6 +249,7 @@ impl SlabTransmission {
             scale: [0.0; 3],
             values: vec![[[0; 3]; slab_profile::ENTRIES]; slab_profile::LOOKUP_NODES],
             exit: vec![[[1.0; 3]; slab_profile::EXIT_BINS]; slab_profile::THICKNESS_NODES],
+            oblique: vec![[[1.0; 3]; slab_profile::OBLIQUE_ROWS]; slab_profile::THICKNESS_NODES],
         }
     }
 
@@ -270,6 +275,9 @@ impl SlabTransmission {
             exit: (0..slab_profile::THICKNESS_NODES)
                 .map(|k| std::array::from_fn(|b| [0, 1, 2].map(|c| channels[c].exit[k][b] as f32)))
                 .collect(),
+            oblique: (0..slab_profile::THICKNESS_NODES)
+                .map(|k| std::array::from_fn(|q| [0, 1, 2].map(|c| channels[c].oblique[k][q] as f32)))
+                .collect(),
         }
     }
 
@@ -288,13 +296,15 @@ impl SlabTransmission {
             })
         });
         let exit = self.exit.iter().flatten().map(|h| [h[0], h[1], h[2], 0.0].map(f32::to_bits));
-        header.chain(pairs).chain(exit).collect()
+        let oblique = self.oblique.iter().flatten().map(|f| [f[0], f[1], f[2], 0.0].map(f32::to_bits));
+        header.chain(pairs).chain(exit).chain(oblique).collect()
     }
 
     /// Texels after the angular factors.
     pub const TEXELS: usize = 1
         + slab_profile::LOOKUP_NODES * slab_profile::ENTRIES
-        + slab_profile::THICKNESS_NODES * slab_profile::EXIT_BINS;
+        + slab_profile::THICKNESS_NODES * slab_profile::EXIT_BINS
+        + slab_profile::THICKNESS_NODES * slab_profile::OBLIQUE_ROWS;
 }
 
 const _: () = assert!(curvature_profile::CURVATURE_NODES == super::CURVATURE_NODES as usize);
