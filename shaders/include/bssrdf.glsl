@@ -159,7 +159,7 @@ vec3 slab_exit_factor(usamplerBuffer table, vec4 header, float t, float cos_o) {
 }
 // The transmitted fraction's change with incidence per channel (mirrors
 // SlabChannel::oblique_factor): light refracted in at sin²θt = `sin2_t` (per channel) through
-// thickness t (mm); rows q at sin²θt = q/(SLAB_OBLIQUE_ROWS − 1) of 1/η² (1 where η < 1),
+// thickness t (mm); rows q at sin²θt = q/(SLAB_OBLIQUE_ROWS − 1) of 1/η² (at most 0.9),
 // linear between rows and between nodes.
 vec3 slab_oblique_factor(usamplerBuffer table, vec4 header, float t, vec3 sin2_t, float eta) {
     float unit_mm = header.x;
@@ -169,7 +169,7 @@ vec3 slab_oblique_factor(usamplerBuffer table, vec4 header, float t, vec3 sin2_t
     float k = min(floor(x), last - 1.0);
     float t0 = slab_node_thickness(k), t1 = slab_node_thickness(k + 1.0);
     float a = clamp((tt - t0) / (t1 - t0), 0.0, 1.0);
-    float row_sin2 = (eta > 1.0 ? 1.0 / (eta * eta) : 1.0) / float(SLAB_OBLIQUE_ROWS - 1u);
+    float row_sin2 = min(1.0 / (eta * eta), 0.9) / float(SLAB_OBLIQUE_ROWS - 1u); // OBLIQUE_LARGEST_SIN2
     int base = SLAB_BASE + 1 + int(SLAB_LOOKUP_NODES * SLAB_ENTRIES + SLAB_THICKNESS_NODES * MC_EXIT_BINS)
              + int(k) * int(SLAB_OBLIQUE_ROWS);
     vec3 factor;

@@ -51,8 +51,11 @@ pub const EXIT_BINS: usize = super::mc_profile::EXIT_BINS;
 pub const ENTRIES: usize = 64;
 
 /// Rows of [`SlabChannel::oblique`]: row q at sin²θt = q / (OBLIQUE_ROWS − 1) of the largest a
-/// refracted ray can have (1/η², or 1 where η < 1).
+/// refracted ray can have (1/η²), held at 0.9 (θt = 72°) where η is near or below 1: a beam
+/// started along the face (θt = 90°) never leaves it, and the walk of η = 0.7 did not end.
 pub const OBLIQUE_ROWS: usize = 6;
+/// The largest sin²θt of the rows (bssrdf.glsl's `slab_oblique_factor` holds the same).
+pub const OBLIQUE_LARGEST_SIN2: f64 = 0.9;
 
 /// The oblique rows walk the normal beam's first batches: a share 1/OBLIQUE_SHARE of them, or as
 /// many as let OBLIQUE_COUNT photons through at normal incidence.
@@ -121,7 +124,7 @@ pub struct SlabChannel {
 
 /// sin²θt of row q of [`SlabChannel::oblique`] for relative index `eta`.
 pub fn oblique_row_sin2(q: usize, eta: f64) -> f64 {
-    let largest = if eta > 1.0 { 1.0 / (eta * eta) } else { 1.0 };
+    let largest = (1.0 / (eta * eta)).min(OBLIQUE_LARGEST_SIN2);
     largest * q as f64 / (OBLIQUE_ROWS - 1) as f64
 }
 
