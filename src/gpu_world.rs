@@ -13,6 +13,7 @@ use crate::gpu::sd_table::{AngularFactors, CurvatureRatios, SlabTransmission};
 use crate::gpu::{GpuChannel, ObjectParams, SdTable, SurfaceConstants};
 use crate::hierarchy::{self, Hierarchy, HierarchyOptions};
 use crate::materials::{Material, ScatterWeight};
+use crate::mesh::occupancy::{self, Occupancy};
 use crate::mesh::Mesh;
 use crate::physics::beam_diffusion::BeamMedium;
 use crate::physics::mc_profile::McProfile;
@@ -449,7 +450,8 @@ impl GpuObject {
             ((crate::gpu::sd_table::TABLE_SIZE
                 + AngularFactors::TEXELS
                 + SlabTransmission::TEXELS
-                + CurvatureRatios::TEXELS)
+                + CurvatureRatios::TEXELS
+                + occupancy::TEXELS)
                 * 16) as u64,
             BufferUsageFlags::UNIFORM_TEXEL_BUFFER,
             MemoryLocation::CpuToGpu,
@@ -549,6 +551,13 @@ fn write_params(params: &mut Buffer, table: &mut Buffer, from: &MadeFrom, point_
     table.write(factors_at as u64, &factors.texels())?;
     let across_at = factors_at + AngularFactors::TEXELS * 16;
     table.write(across_at as u64, &across.texels())?;
-    table.write((across_at + SlabTransmission::TEXELS * 16) as u64, &curvature.texels())?;
+    let curvature_at = across_at + SlabTransmission::TEXELS * 16;
+    table.write(curvature_at as u64, &curvature.texels())?;
+    // The object's inside, for the Monte Carlo table's pairs (its chord through the medium).
+    let inside = match from.table {
+        TableProfile::MonteCarlo => Occupancy::of(&from.mesh),
+        _ => None,
+    };
+    table.write((curvature_at + CurvatureRatios::TEXELS * 16) as u64, &Occupancy::texels(inside.as_ref()))?;
     Ok(spacing_mm / from.mm_per_unit)
 }

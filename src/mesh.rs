@@ -3,6 +3,7 @@
 //! shapes. One index stream is shared by positions and normals.
 
 pub mod curvature;
+pub mod occupancy;
 pub mod off;
 pub mod ply;
 

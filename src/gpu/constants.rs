@@ -42,6 +42,10 @@ pub const CURVATURE_SIN2_PERCENT_2: u32 = 96;
 /// Entries of the Monte Carlo table's exit tilt, after the curvature rows.
 pub const EXIT_TILT_ENTRIES: u32 = 256;
 
+/// Cells per axis of the grid of an object's inside (src/mesh/occupancy.rs), after the Sd
+/// table's curvature rows (a multiple of 8, so that the bits fill whole texels).
+pub const OCCUPANCY_CELLS: u32 = 64;
+
 /// Set in a tree node's child index when the child is a point (index into the sorted points).
 pub const LEAF_BIT: u32 = 0x8000_0000;
 
@@ -102,4 +106,5 @@ pub const GLSL_CONSTANTS: &[(&str, u32)] = &[
     ("MAX_CUT_STEPS", MAX_CUT_STEPS),
     ("MAX_LIST_EVALUATIONS", MAX_LIST_EVALUATIONS),
     ("DIPOLE_TABLE_SIZE", DIPOLE_TABLE_SIZE),
+    ("OCCUPANCY_CELLS", OCCUPANCY_CELLS),
 ];
