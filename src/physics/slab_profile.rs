@@ -19,7 +19,7 @@
 //! perpendicular, so nothing jumps), with the exit factor h_T read once per pixel at the
 //! luminance-weighted mean thickness of its sources across, and the transmitted fraction's change
 //! with the light's angle of incidence ([`SlabChannel::oblique_factor`]: light refracted
-//! obliquely into Skin1's 2 mm slab, θt = 42°, lets through 1.10 / 1.03 / 0.91 (R G B) of what
+//! obliquely into Skin1's 2 mm slab, θt = 42°, lets through 1.10 / 1.03 / 0.92 (R G B) of what
 //! enters at normal incidence: less of it crosses unscattered, and it scatters first nearer the
 //! near face; read at normal incidence the back-lit 2 mm slab at 60° was 0.944 1.029 1.135 of
 //! the path tracer). Between nodes the profile
