@@ -24,7 +24,8 @@ layout(binding = 2) uniform usamplerBuffer tables;
 
 layout(push_constant) uniform EvalConstants {
     uint count;
-    uint model; // 0 directional dipole, 1 classical dipole, 2 photon beam diffusion, 3 Monte Carlo table
+    uint model; // 0 directional dipole, 1 classical dipole, 2 photon beam diffusion, 3 Monte Carlo table,
+                // EVAL_JOINED_INSIDE: joined_inside of the pair (1 or 0)
 } pc;
 
 void main() {
@@ -32,7 +33,10 @@ void main() {
     if (i >= pc.count) return;
     BssrdfQuery q = queries[i];
     float value;
-    if (pc.model == MODEL_DIRECTIONAL) {
+    if (pc.model == EVAL_JOINED_INSIDE) {
+        // `tables` holds one object's inside from texel 0 (mesh::occupancy).
+        value = joined_inside(tables, 0, occupancy_header(tables, 0), q.xi.xyz, q.ni.xyz, q.xo.xyz, q.no.xyz) ? 1.0 : 0.0;
+    } else if (pc.model == MODEL_DIRECTIONAL) {
         value = dirpole_sd(q.channel, q.xi.xyz, q.ni.xyz, q.wi.xyz, q.xo.xyz, q.no.xyz);
     } else if (pc.model == MODEL_PBD || pc.model == MODEL_MC) {
         // As the shade pass reads it.

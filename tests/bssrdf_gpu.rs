@@ -267,3 +267,57 @@ fn gpu_curvature_terms_match_cpu() {
     );
     assert!(checked > n * 9 / 10, "only {checked} of {n} queries checked");
 }
+
+/// The shade pass's test of whether a pair is joined inside its object (bssrdf.glsl
+/// `joined_inside`) against its Rust mirror (mesh::occupancy::joined_inside), on pairs of points
+/// of the torus's surface (and the default bunny's where glmark2-data is installed): the same
+/// answer for all but a few pairs whose arc passes within f32 rounding of a cell's face.
+#[test]
+fn joined_inside_matches_its_mirror() {
+    use translucent::mesh::occupancy::{joined_inside, Occupancy};
+    use translucent::mesh::Mesh;
+    let (ctx, counts) = validated_context();
+    let pass = BssrdfEvalPass::new(&ctx).unwrap();
+    let mut meshes = vec![("torus", Mesh::torus(1.0, 0.3, 64, 32))];
+    let bunny = std::path::Path::new("/usr/share/glmark2/models/bunny.obj");
+    if bunny.exists() {
+        meshes.push(("bunny", Mesh::load(bunny).unwrap()));
+    }
+    for (name, mesh) in meshes {
+        let grid = Occupancy::of(&mesh).expect("a closed mesh");
+        // Points on the surface, with their interpolated normals (a fixed LCG).
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let triangles = mesh.indices.len() / 3;
+        let mut point = || {
+            let t = ((next() * triangles as f32) as usize).min(triangles - 1);
+            let (mut u, mut v) = (next(), next());
+            if u + v > 1.0 {
+                (u, v) = (1.0 - u, 1.0 - v);
+            }
+            let [a, b, c] = [0, 1, 2].map(|k| mesh.indices[3 * t + k] as usize);
+            let p = mesh.positions[a] * (1.0 - u - v) + mesh.positions[b] * u + mesh.positions[c] * v;
+            let n = (mesh.normals[a] * (1.0 - u - v) + mesh.normals[b] * u + mesh.normals[c] * v).normalize();
+            (p, n)
+        };
+        let pairs: Vec<[glam::Vec3; 4]> = (0..40_000)
+            .map(|_| {
+                let ((xi, ni), (xo, no)) = (point(), point());
+                [xi, ni, xo, no]
+            })
+            .collect();
+        let gpu = pass.joined_inside(&ctx, &grid, &pairs).unwrap();
+        let cpu: Vec<bool> = pairs.iter().map(|&[xi, ni, xo, no]| joined_inside(Some(&grid), xi, ni, xo, no)).collect();
+        let apart = gpu.iter().zip(&cpu).filter(|(g, c)| g != c).count();
+        let through_air = cpu.iter().filter(|&&c| !c).count();
+        println!("{name}: {through_air} of {} pairs through the air; GPU and CPU differ on {apart}", pairs.len());
+        assert!(through_air > 1_000, "{name}: too few pairs through the air to test ({through_air})");
+        assert!(apart * 1000 <= pairs.len(), "{name}: GPU and CPU differ on {apart} pairs");
+    }
+    drop(pass);
+    drop(ctx);
+    assert_clean(&counts);
+}

@@ -164,20 +164,10 @@ vec3 refracted_sin2(vec3 toward[3], vec3 ni) {
     return vec3(entry_sin2(toward[0], ni), entry_sin2(toward[1], ni), entry_sin2(toward[2], ni)) / (eta * eta);
 }
 
-// Whether light goes from xi to xo inside the object (the Monte Carlo table only). A chord that
-// leaves neither end's surface (xo − xi below xi's tangent plane and above xo's, as every pair
-// of a convex object) is inside. One that leaves either is tested against the object's inside
-// (through_medium): where even an arc sagging into the object crosses air (an ear beside the
-// other, across a torus's hole, a paw and the chest above it) light that stays in the medium
-// has no short way, and the path tracer's light that exits once has none of it. (The straight
-// chord alone was too strict: on a bumpy front-lit surface the chords between bumps graze the
-// air, and the Skin1 bunny under a far point light lost 7% of its red.)
+// Whether light goes from xi to xo inside the object (bssrdf.glsl `joined_inside`, the Monte
+// Carlo table only).
 bool joined_inside(vec3 xi, vec3 ni, vec3 xo, vec3 no) {
-    vec3 d = xo - xi;
-    // Leaving by less than ~3° is a face's round-off or its facets, not air (the box's faces).
-    float lean = 0.05 * length(d);
-    if (dot(d, ni) <= lean && dot(d, no) >= -lean) return true;
-    return through_medium(dipole_table, object_inside, xi, ni, xo, no);
+    return joined_inside(dipole_table, OCCUPANCY_BASE, object_inside, xi, ni, xo, no);
 }
 
 vec3 source(vec3 xi, vec3 ni, vec3 wi, vec3 power, vec3 xo, vec3 no) {
@@ -306,7 +296,7 @@ void node_sigma(uint index, vec3 ni, vec3 xo, out vec3 center, out vec3 offset, 
 void begin_sources(vec4 normal_curvature) {
     dipole_header = dipole_table_header(dipole_table);
     slab_header = MODEL == MODEL_MC ? slab_header_of(dipole_table) : vec4(0.0);
-    object_inside = MODEL == MODEL_MC ? occupancy_header(dipole_table) : Occupancy(vec4(0.0), vec3(1.0));
+    object_inside = MODEL == MODEL_MC ? occupancy_header(dipole_table, OCCUPANCY_BASE) : Occupancy(vec4(0.0), vec3(1.0));
     if (MODEL == MODEL_MC) pixel_curvature_mm = normal_curvature.w / object_params.mm_per_unit;
     pixel_curvature_rows = MODEL == MODEL_MC ? curvature_rows(dipole_table, pixel_curvature_mm)
                                              : vec4(-1.0, 0.0, 0.0, 0.0);

@@ -12,6 +12,9 @@ pub const MODEL_DIPOLE: u32 = 1;
 pub const MODEL_PBD: u32 = 2;
 /// The same for the half-space's Monte Carlo table (its Sd table, and the angular factors after it).
 pub const MODEL_MC: u32 = 3;
+/// The BSSRDF evaluation's push constant for whether a pair is joined inside its object
+/// (bssrdf.glsl `joined_inside`, cross-tested against mesh::occupancy).
+pub const EVAL_JOINED_INSIDE: u32 = 16;
 /// Nodes of the Monte Carlo table's incidence factor and bins of its exit factor
 /// (src/physics/mc_profile.rs's INCIDENCE_NODES and EXIT_BINS; checked equal in gpu::sd_table).
 pub const MC_INCIDENCE_NODES: u32 = 8;
@@ -107,4 +110,5 @@ pub const GLSL_CONSTANTS: &[(&str, u32)] = &[
     ("MAX_LIST_EVALUATIONS", MAX_LIST_EVALUATIONS),
     ("DIPOLE_TABLE_SIZE", DIPOLE_TABLE_SIZE),
     ("OCCUPANCY_CELLS", OCCUPANCY_CELLS),
+    ("EVAL_JOINED_INSIDE", EVAL_JOINED_INSIDE),
 ];

@@ -4,11 +4,12 @@
 
 use std::collections::HashMap;
 
-use glam::Vec4;
+use glam::{Vec3, Vec4};
 
 use crate::error::Result;
 use crate::gpu::sd_table::TABLE_SIZE;
-use crate::gpu::{BssrdfQueryGpu, EvalConstants, GpuChannel, SdTable};
+use crate::gpu::{BssrdfQueryGpu, EvalConstants, GpuChannel, SdTable, EVAL_JOINED_INSIDE};
+use crate::mesh::occupancy::Occupancy;
 use crate::physics::beam_diffusion::BeamMedium;
 use crate::physics::{Diffusion, Medium, Model, Query};
 use crate::vk::{Bind, Buffer, BufferUsageFlags, Context, MemoryLocation, Pipeline};
@@ -79,6 +80,30 @@ impl BssrdfEvalPass {
     }
 
     /// One dispatch: Sd for `rows`, row i reading table `tables_of[i]` of `tables`.
+    /// Whether each pair (xi, ni, xo, no) is joined inside the object of `grid`, as the shade pass
+    /// decides it (bssrdf.glsl `joined_inside`; the GPU's mirror of
+    /// [`crate::mesh::occupancy::joined_inside`]).
+    pub fn joined_inside(&self, ctx: &Context, grid: &Occupancy, pairs: &[[Vec3; 4]]) -> Result<Vec<bool>> {
+        let tables = texel_buffer(ctx, &Occupancy::texels(Some(grid)))?;
+        let mut out = Vec::with_capacity(pairs.len());
+        for part in pairs.chunks(1 << 16) {
+            let packed: Vec<BssrdfQueryGpu> = part
+                .iter()
+                .map(|&[xi, ni, xo, no]| BssrdfQueryGpu {
+                    channel: bytemuck::Zeroable::zeroed(),
+                    xi: xi.extend(0.0),
+                    ni: ni.extend(0.0),
+                    wi: Vec4::ZERO,
+                    xo: xo.extend(0.0),
+                    no: no.extend(0.0),
+                    table: [0; 4],
+                })
+                .collect();
+            out.extend(self.dispatch_packed(ctx, &packed, &tables, EVAL_JOINED_INSIDE)?.iter().map(|&v| v != 0.0));
+        }
+        Ok(out)
+    }
+
     fn dispatch(
         &self,
         ctx: &Context,
@@ -88,16 +113,25 @@ impl BssrdfEvalPass {
         model: Model,
         diffusion: Diffusion,
     ) -> Result<Vec<f32>> {
-        let row_bytes = std::mem::size_of::<BssrdfQueryGpu>();
         let packed: Vec<BssrdfQueryGpu> = rows.iter().zip(tables_of).map(|(q, &t)| pack(q, diffusion, t)).collect();
+        self.dispatch_packed(ctx, &packed, tables, model.gpu_code())
+    }
+
+    fn dispatch_packed(
+        &self,
+        ctx: &Context,
+        packed: &[BssrdfQueryGpu],
+        tables: &Buffer,
+        model: u32,
+    ) -> Result<Vec<f32>> {
         let mut input = Buffer::new(
             ctx,
             "bssrdf queries",
-            (packed.len() * row_bytes) as u64,
+            std::mem::size_of_val(packed) as u64,
             BufferUsageFlags::STORAGE_BUFFER,
             MemoryLocation::CpuToGpu,
         )?;
-        input.write(0, &packed)?;
+        input.write(0, packed)?;
         let results = Buffer::new(
             ctx,
             "bssrdf results",
@@ -105,7 +139,7 @@ impl BssrdfEvalPass {
             BufferUsageFlags::STORAGE_BUFFER,
             MemoryLocation::GpuToCpu,
         )?;
-        let constants = EvalConstants { count: packed.len() as u32, model: model.gpu_code() };
+        let constants = EvalConstants { count: packed.len() as u32, model };
         let groups = packed.len().div_ceil(GROUP) as u32;
         ctx.submit(None, |rec| {
             rec.dispatch(
