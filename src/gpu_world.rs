@@ -446,7 +446,8 @@ impl GpuObject {
         let mut sd_table = Buffer::new(
             ctx,
             "Sd table",
-            // A header texel, TABLE_SIZE - 1 pairs, the angular factors and the slab's transmission.
+            // A header texel, TABLE_SIZE - 1 pairs, the angular factors, the slab's transmission, the
+            // curvature rows and the object's inside (its mesh's, not its material's: one buffer per object).
             ((crate::gpu::sd_table::TABLE_SIZE
                 + AngularFactors::TEXELS
                 + SlabTransmission::TEXELS
