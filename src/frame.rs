@@ -250,6 +250,12 @@ impl Renderer {
         self.world.objects.first().map(|o| &o.hierarchy)
     }
 
+    /// How many grids of an object's inside the frames so far made (one per mesh the Monte Carlo
+    /// table read; a change of material or model makes none).
+    pub fn inside_grids_made(&self) -> u64 {
+        self.world.inside_grids_made
+    }
+
     /// Every translucent object's sample count (from the last frame).
     pub fn point_counts(&self) -> Vec<u32> {
         self.world.objects.iter().map(|o| o.hierarchy.point_count).collect()

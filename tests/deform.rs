@@ -11,6 +11,7 @@ use translucent::frame_desc::{FrameDesc, Integration};
 use translucent::materials::Material;
 use translucent::mesh::Mesh;
 use translucent::output::{self, Exposure};
+use translucent::physics::Model;
 use translucent::scene::{Camera, Light};
 use translucent::world::World;
 
@@ -57,6 +58,40 @@ fn each_frame_samples_the_deformed_surface() {
         }
         assert!((areas[1] - areas[3]).abs() < 1e-4 * areas[1], "the period's two halves mirror: {areas:?}");
     }
+    drop(renderer);
+    assert_clean(&counts);
+}
+
+/// The grid of an object's inside (which the Monte Carlo table reads) is made once per mesh: a
+/// change of material, or to another model and back, keeps it; a new mesh makes one again.
+#[test]
+fn the_inside_grid_is_made_once_per_mesh() {
+    let (ctx, counts) = validated_context();
+    let base = Mesh::torus(1.0, 0.4, 32, 16);
+    let camera = Camera::framing(Vec3::ZERO, 2.0, 40.0, Vec3::new(0.3, 0.3, 1.0));
+    let lights = vec![Light::Directional { toward: Vec3::new(0.2, 1.0, 0.5), irradiance: Vec3::ONE }];
+    let mut world = World::single(base.clone(), Material::find("marble").unwrap(), 10.0);
+    world.objects[0].samples = Some(1024);
+    let mut desc = frame_for(camera, lights);
+    desc.integration.model = Model::Mc;
+    let mut renderer = Renderer::new(ctx, false).expect("renderer");
+    let mut frame = |world: &World, desc: &FrameDesc| {
+        renderer.render_frame(world, desc).unwrap();
+        renderer.inside_grids_made()
+    };
+    assert_eq!(frame(&world, &desc), 1, "the first frame makes the grid");
+    world.objects[0].material = Material::find("skin1").unwrap();
+    assert_eq!(frame(&world, &desc), 1, "a new material keeps it");
+    let mut other = desc.clone();
+    other.integration.model = Model::Directional;
+    assert_eq!(frame(&world, &other), 1, "a model without the grid needs none");
+    assert_eq!(frame(&world, &desc), 1, "back to the Monte Carlo table: the same grid");
+    world.objects[0].mesh = Animation::new("torus", &base, Some(Deformation::Squash(0.5)), 2, Vec3::Y)
+        .unwrap()
+        .expect("animated")
+        .mesh(1)
+        .unwrap();
+    assert_eq!(frame(&world, &desc), 2, "a new mesh makes it again");
     drop(renderer);
     assert_clean(&counts);
 }
