@@ -299,26 +299,41 @@ impl Mesh {
     /// position, so duplicated vertices count as one): a closed, consistently wound surface.
     pub fn is_closed(&self) -> bool {
         // Welded on a grid a millionth of the mesh's size: a seam's two copies of a vertex
-        // (cos 0 and cos 2π) differ in the last bits.
+        // (cos 0 and cos 2π) differ in the last bits. Each vertex takes the rank of its grid
+        // cell among the cells in use.
         let (lo, hi) = self.bounds();
         let cell = ((hi - lo).max_element() as f64 * 1e-6).max(f64::MIN_POSITIVE);
-        let key = |i: u32| {
-            let p = (self.positions[i as usize] - lo).as_dvec3() / cell;
-            [p.x.round() as i64, p.y.round() as i64, p.z.round() as i64]
-        };
-        let mut edges: std::collections::HashMap<([i64; 3], [i64; 3]), i32> = std::collections::HashMap::new();
+        let keys: Vec<[i64; 3]> = (self.positions.iter())
+            .map(|&p| {
+                let p = (p - lo).as_dvec3() / cell;
+                [p.x.round() as i64, p.y.round() as i64, p.z.round() as i64]
+            })
+            .collect();
+        let mut order: Vec<u32> = (0..keys.len() as u32).collect();
+        order.sort_unstable_by_key(|&i| keys[i as usize]);
+        let mut welded = vec![0u32; keys.len()];
+        for k in 1..order.len() {
+            let (previous, this) = (order[k - 1] as usize, order[k] as usize);
+            welded[this] = welded[previous] + u32::from(keys[this] != keys[previous]);
+        }
+        // Closed and consistently wound: every edge is crossed as often from a to b as from b to
+        // a, that is, the directed edges sorted are the reversed ones sorted. (Sorted vectors
+        // rather than a map of edges: 0.1 s rather than 1.8 s for two million triangles.)
+        let mut forward: Vec<u64> = Vec::with_capacity(self.indices.len());
         for t in self.indices.chunks_exact(3) {
             for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
-                let (ka, kb) = (key(a), key(b));
-                if ka == kb {
-                    continue;
+                let (a, b) = (welded[a as usize], welded[b as usize]);
+                if a != b {
+                    forward.push((u64::from(a) << 32) | u64::from(b));
                 }
-                // +1 for a → b, −1 for b → a, on the edge's sorted key.
-                let (k, sign) = if ka < kb { ((ka, kb), 1) } else { ((kb, ka), -1) };
-                *edges.entry(k).or_insert(0) += sign;
             }
         }
-        !edges.is_empty() && edges.values().all(|&v| v == 0)
+        let mut backward: Vec<u64> = forward.iter().map(|e| e.rotate_left(32)).collect();
+        std::thread::scope(|s| {
+            s.spawn(|| backward.sort_unstable());
+            forward.sort_unstable();
+        });
+        !forward.is_empty() && forward == backward
     }
 
     /// The volume enclosed (positive when wound counter-clockwise seen from outside), about the

@@ -19,6 +19,37 @@ fn assert_winding_matches_normals(mesh: &Mesh, what: &str) {
     }
 }
 
+/// A closed mesh crosses each edge once each way, welded by position (the built-in shapes' seams
+/// and a slab's faces duplicate vertices); a hole, a flipped triangle or a mesh without
+/// triangles is not closed. At two million triangles too (the inside grid and every mesh load
+/// ask; it answers from sorted edge lists).
+#[test]
+fn closed_meshes_are_told_from_open_and_misturned_ones() {
+    for (name, mesh) in [
+        ("sphere", Mesh::sphere(1.0, 48)),
+        ("slab", Mesh::slab(4.0, 4.0, 1.0)),
+        ("torus", Mesh::torus(1.0, 0.35, 64, 32)),
+        ("large sphere", Mesh::sphere(1.0, 724)),
+    ] {
+        assert!(mesh.is_closed(), "{name}");
+        let mut holed = mesh.clone();
+        holed.indices.truncate(holed.indices.len() - 3);
+        assert!(!holed.is_closed(), "{name} less its last triangle");
+        let mut flipped = mesh.clone();
+        flipped.indices.swap(0, 1);
+        assert!(!flipped.is_closed(), "{name} with a triangle wound the other way");
+        // Two triangles back to back over the last one's edges: every edge crossed once each
+        // way more, still closed (a zero-volume fin).
+        let mut finned = mesh.clone();
+        let last: Vec<u32> = mesh.indices[mesh.indices.len() - 3..].to_vec();
+        finned.indices.extend([last[0], last[2], last[1], last[0], last[1], last[2]]);
+        assert!(finned.is_closed(), "{name} with a fin");
+    }
+    let mut empty = Mesh::sphere(1.0, 8);
+    empty.indices.clear();
+    assert!(!empty.is_closed(), "no triangles");
+}
+
 #[test]
 fn procedural_shapes_are_valid_and_wound_outward() {
     for (name, mesh, area) in [
