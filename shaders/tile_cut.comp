@@ -46,7 +46,7 @@ layout(push_constant) uniform TileCutConstants {
     uint model;       // the shade pass's model (MODEL_DIRECTIONAL...): whether the normal enters Sd
 } pc;
 
-const uint END = 0xffffffffu;
+const uint END = WALK_END;
 
 // The squared distance from p to the box [lo, hi] (0 inside).
 float distance2_to_box(vec3 p, vec3 lo, vec3 hi) {
@@ -60,16 +60,9 @@ float box_distance2(vec3 lo, vec3 hi, vec3 a, vec3 b) {
     return dot(d, d);
 }
 
-// The subtree after the one whose last point is `last`, in depth-first order (left child
-// first): it starts at point last + 1, and in Karras's layout an internal node's range has the
-// node's own index at one end, so it is internal node last + 1 if that node's range starts
-// there, else the point itself. No stack: llvmpipe keeps a private array per lane, and the
-// walk's pushes and pops cost more than this one extra texel.
+// The subtree after the one whose last point is `last` (points.glsl).
 uint next_after(uint last) {
-    uint next = last + 1u;
-    if (next >= object_params.point_count) return END;
-    if (next < object_params.node_count && texel(nodes, next * NODE_TEXELS + 3u).z == next) return next;
-    return next | LEAF_BIT;
+    return walk_next_after(nodes, object_params.point_count, object_params.node_count, last);
 }
 
 // Counts (write = false) or writes (write = true, at `first`) the tile's list; returns the counts

@@ -460,6 +460,12 @@ pub struct RenderArgs {
     /// and interpolated, within about 0.1% of each source's contribution.
     #[arg(long)]
     pub no_far_field: bool,
+    /// Draw light that leaves the object and enters it again (an ear lit through glowing onto
+    /// the other, a paw onto the chest): `--model mc` on a closed mesh, with the tree (not with
+    /// --brute-force), by a gather over 1024 patches of the surface before the shade pass. Costs
+    /// about 2x the shade pass on a back-lit object, whose shadowed side it lights.
+    #[arg(long)]
+    pub reentry: bool,
     /// Leave out the surface's own (microfacet) reflection: subsurface scattering alone.
     #[arg(long)]
     pub no_specular: bool,

@@ -19,6 +19,7 @@ use crate::passes::debug_view::{self, DebugViewPass};
 use crate::passes::diffuse::DiffusePass;
 use crate::passes::far_field::{FarFieldInputs, FarFieldPass};
 use crate::passes::irradiance::IrradiancePass;
+use crate::passes::reentry::{self, ReentryInputs, ReentryPass};
 use crate::passes::sampling::SamplingPass;
 use crate::passes::shade::{self, ShadeInputs, ShadePass, SurfaceDraw};
 use crate::passes::shadow::{Caster, ShadowPass};
@@ -250,6 +251,16 @@ impl Renderer {
         self.world.objects.first().map(|o| &o.hierarchy)
     }
 
+    /// The last frame's re-entry patches of object `k` (passes::reentry), or None where it has
+    /// none (not the Monte Carlo table, or not a closed mesh).
+    pub fn reentry_patches(&self, k: usize) -> Result<Option<reentry::Patches>> {
+        let Some(o) = self.world.objects.get(k) else { return Ok(None) };
+        let Some(profile) = &o.reentry_profile else { return Ok(None) };
+        let h = &o.hierarchy;
+        let constants = reentry::constants(h.point_count, reentry::total_area(o.point_spacing, h.point_count), profile);
+        Ok(Some(o.reentry.download(&self.ctx, constants)?))
+    }
+
     /// How many grids of an object's inside the frames so far made (one per mesh the Monte Carlo
     /// table read; a change of material or model makes none).
     pub fn inside_grids_made(&self) -> u64 {
@@ -400,6 +411,7 @@ struct Passes {
     hierarchy: HierarchyPasses,
     tile_cut: TileCutPass,
     far_field: FarFieldPass,
+    reentry: ReentryPass,
     shade: ShadePass,
     debug_view: DebugViewPass,
     diffuse: DiffusePass,
@@ -413,6 +425,7 @@ impl Passes {
             hierarchy: HierarchyPasses::new(ctx)?,
             tile_cut: TileCutPass::new(ctx)?,
             far_field: FarFieldPass::default(),
+            reentry: ReentryPass::new(ctx)?,
             shade: ShadePass::new(ctx)?,
             debug_view: DebugViewPass::new(ctx)?,
             diffuse: DiffusePass::new(ctx)?,
@@ -511,6 +524,15 @@ impl HierarchyPasses {
         // Each node's summary of its points, bottom-up.
         rec.scope("tree summaries", |rec| self.tree.record_aggregate(rec, &tree, n))
     }
+
+    /// The tree's summaries made again from its points' irradiance and records (after the
+    /// re-entry added to them): the tree again (which clears the summaries' arrival counters),
+    /// then the summaries.
+    pub fn record_summaries_again(&self, rec: &mut Recorder, h: &Hierarchy) -> Result<()> {
+        let (tree, n) = (h.tree_buffers(), h.point_count);
+        self.tree.record_build(rec, &tree, n)?;
+        self.tree.record_aggregate(rec, &tree, n)
+    }
 }
 
 impl Renderer {
@@ -583,6 +605,8 @@ impl Renderer {
             self.passes.shade.prepare(&self.ctx, shade_variant(&desc), integration.brute_force)?;
         }
         let cut = shading && !integration.brute_force;
+        // Brute force sums each light's own records, which hold no re-entered light.
+        let reentry_drawn = shading && integration.reentry && !integration.brute_force;
         let far_field = integration.uses_far_field();
         let objects = self.world.objects.len();
         let w = &self.world;
@@ -626,6 +650,26 @@ impl Renderer {
                     &o.sd_table,
                     &casters,
                 )?;
+                // Light that leaves the object and enters it again, added to the points' own.
+                if let (true, Some(profile)) = (reentry_drawn, &o.reentry_profile) {
+                    let h = &o.hierarchy;
+                    let total_area = reentry::total_area(o.point_spacing, h.point_count);
+                    let constants = reentry::constants(h.point_count, total_area, profile);
+                    let inputs = ReentryInputs {
+                        object_params: &o.params,
+                        nodes: &h.nodes,
+                        points: &h.sorted_points,
+                        node_flux: &h.node_flux,
+                        point_flux: &h.sorted_point_flux,
+                        point_spread: &h.sorted_point_spread,
+                        sd_table: &o.sd_table,
+                        buffers: &o.reentry,
+                    };
+                    rec.scope("re-entry", |rec| {
+                        self.passes.reentry.record(rec, &inputs, &constants)?;
+                        self.passes.hierarchy.record_summaries_again(rec, h)
+                    })?;
+                }
             }
             if let Some(shadows) = &w.opaque_shadows {
                 // The opaque objects' shadow maps, of every object.

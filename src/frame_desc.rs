@@ -57,6 +57,10 @@ pub struct Integration {
     /// tree, not the Monte Carlo table (whose light across an object is not smooth across a
     /// tile), in tiles that qualify (tile_cut.comp).
     pub far_field: bool,
+    /// Whether light that leaves the object and enters it again is drawn (passes::reentry: the
+    /// Monte Carlo table on a closed mesh, with the tree). Off by default: it lights the shadowed
+    /// side that the tree's cut skipped, about 2x the shade pass on the default back-lit bunny.
+    pub reentry: bool,
 }
 
 /// The Monte Carlo table's terms a frame draws: the shade pass's single scattering (light
@@ -125,6 +129,7 @@ impl Default for Integration {
             brute_force: false,
             near_field: NearField::Auto,
             far_field: true,
+            reentry: false,
         }
     }
 }

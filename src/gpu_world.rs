@@ -17,6 +17,7 @@ use std::cell::OnceCell;
 
 use crate::mesh::occupancy::{self, Occupancy};
 use crate::mesh::Mesh;
+use crate::passes::reentry::{self, ReentryBuffers, ReentryProfile};
 use crate::physics::beam_diffusion::BeamMedium;
 use crate::physics::mc_profile::McProfile;
 use crate::physics::{curvature_profile, slab_profile};
@@ -53,6 +54,10 @@ pub struct GpuObject {
     /// needs it and kept until the mesh changes: a change of material, model or scale rewrites
     /// the Sd table but does not pay for it again (0.9 s for a million triangles).
     inside: OnceCell<Option<Occupancy>>,
+    /// For light that leaves and enters it again (passes::reentry, the Monte Carlo table on a
+    /// closed mesh only): the flat profile's near integral and reach, and ∫ Ft cos dω.
+    pub reentry_profile: Option<ReentryProfile>,
+    pub reentry: ReentryBuffers,
     /// What the buffers above were made from.
     made_from: MadeFrom,
 }
@@ -374,7 +379,8 @@ impl GpuWorld {
                 (g.made_from.diffusion, g.made_from.mm_per_unit) = (diffusion, world.mm_per_unit);
                 g.made_from.table = table;
                 let grid = inside_grid(&g.inside, &g.made_from, &mut self.inside_grids_made);
-                g.point_spacing = write_params(&mut g.params, &mut g.sd_table, &g.made_from, grid, point_count)?;
+                (g.point_spacing, g.reentry_profile) =
+                    write_params(&mut g.params, &mut g.sd_table, &g.made_from, grid, point_count)?;
                 // Its smoothing length is the material's, in scene units.
                 ctx.wait_idle()?;
                 g.curvature = curvature_buffer(ctx, &g.made_from)?;
@@ -478,7 +484,8 @@ impl GpuObject {
         )?;
         let inside = OnceCell::new();
         let grid = inside_grid(&inside, &made_from, grids_made);
-        let point_spacing = write_params(&mut params, &mut sd_table, &made_from, grid, options.point_count)?;
+        let (point_spacing, reentry_profile) =
+            write_params(&mut params, &mut sd_table, &made_from, grid, options.point_count)?;
         let curvature = curvature_buffer(ctx, &made_from)?;
         Ok(GpuObject {
             hierarchy,
@@ -492,6 +499,8 @@ impl GpuObject {
             curvature,
             point_spacing,
             inside,
+            reentry_profile,
+            reentry: ReentryBuffers::new(ctx)?,
             made_from,
         })
     }
@@ -534,14 +543,15 @@ fn inside_grid<'a>(cell: &'a OnceCell<Option<Occupancy>>, from: &MadeFrom, made:
 }
 
 /// Writes an object's parameters and its Sd table from what it is made from and the grid of its
-/// inside (`inside_grid`); returns the points' mean spacing in scene units.
+/// inside (`inside_grid`); returns the points' mean spacing in scene units, and where the Monte
+/// Carlo table has a grid, what the re-entry needs of its profile (`GpuObject::reentry_profile`).
 fn write_params(
     params: &mut Buffer,
     table: &mut Buffer,
     from: &MadeFrom,
     inside: Option<&Occupancy>,
     point_count: u32,
-) -> Result<f32> {
+) -> Result<(f32, Option<ReentryProfile>)> {
     let constants = |c: usize| from.material.channel(c).constants(from.diffusion);
     let channels = [0, 1, 2].map(|c| GpuChannel::from(&constants(c)));
     let area_mm2 = from.mesh.surface_area() * from.mm_per_unit * from.mm_per_unit;
@@ -561,6 +571,7 @@ fn write_params(
             pad: 0.0,
         }],
     )?;
+    let mut reentry_profile = None;
     let (sd_table, factors, across, curvature) = match from.table {
         TableProfile::Dipole => (
             SdTable::dipole(&[0, 1, 2].map(constants)),
@@ -584,6 +595,21 @@ fn write_params(
                 (profiles, slabs, curved.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
             });
             let sd_table = SdTable::monte_carlo(&profiles, &[0, 1, 2].map(constants));
+            if inside.is_some() {
+                let reach_mm = (reentry::REACH_SPACINGS * spacing_mm) as f64;
+                let mut near = reentry::near_integral(|c, r| profiles[c].sd(r), reach_mm);
+                // Single scattering leaves too (the shade pass draws it along the view ray): all
+                // of it where it entered, the fraction at normal incidence (0.05-0.07 of what
+                // enters Skin1, near all its multiple scattering's in blue).
+                for c in 0..3 {
+                    near[c] += (profiles[c].single_escape / profiles[c].exit_norm) as f32;
+                }
+                reentry_profile = Some(ReentryProfile {
+                    near,
+                    exit_integral: profiles[0].exit_norm as f32,
+                    eta: from.material.eta as f32,
+                });
+            }
             let factors = AngularFactors::monte_carlo(&profiles);
             (sd_table, factors, SlabTransmission::monte_carlo(&slabs), CurvatureRatios::monte_carlo(&curved, &profiles))
         }
@@ -597,5 +623,5 @@ fn write_params(
     table.write(curvature_at as u64, &curvature.texels())?;
     // The object's inside, for the Monte Carlo table's pairs (its chord through the medium).
     table.write((curvature_at + CurvatureRatios::TEXELS * 16) as u64, &Occupancy::texels(inside))?;
-    Ok(spacing_mm / from.mm_per_unit)
+    Ok((spacing_mm / from.mm_per_unit, reentry_profile))
 }

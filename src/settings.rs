@@ -254,6 +254,7 @@ impl RenderSettings {
             brute_force: args.brute_force,
             near_field: args.near_field.into(),
             far_field: !args.no_far_field,
+            reentry: args.reentry,
         };
         (d.width, d.height) = (args.width, args.height);
         (d.specular, d.roughness) = (!args.no_specular, args.roughness);

@@ -206,6 +206,22 @@ fn push_constants_match_glsl() {
         offset_of!(FarFieldConstants, eye),
     ];
     assert_eq!(offsets("far_field.comp", "FarFieldConstants"), far.map(|o| o as u32));
+    // The re-entry's three stages share one block (include/reentry.glsl).
+    use translucent::gpu::ReentryConstants;
+    let reentry = [
+        offset_of!(ReentryConstants, patch_count),
+        offset_of!(ReentryConstants, stride),
+        offset_of!(ReentryConstants, point_count),
+        offset_of!(ReentryConstants, epsilon),
+        offset_of!(ReentryConstants, near),
+        offset_of!(ReentryConstants, exit_integral),
+        offset_of!(ReentryConstants, patch_area),
+        offset_of!(ReentryConstants, eta),
+        offset_of!(ReentryConstants, patch_spacing),
+    ];
+    for stage in ["reentry/exitance.comp", "reentry/gather.comp", "reentry/spread.comp"] {
+        assert_eq!(offsets(stage, "ReentryConstants"), reentry.map(|o| o as u32), "{stage}");
+    }
     // The surface pass, and the opaque objects' shading.
     use translucent::gpu::{DiffuseConstants, SurfaceConstants};
     let surface = [

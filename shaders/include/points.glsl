@@ -90,6 +90,20 @@ const uint POINT_SPREAD_TEXELS = 2u;
 uvec4 texel(usamplerBuffer records, uint index) { return texelFetch(records, int(index)); }
 vec4 texel_float(usamplerBuffer records, uint index) { return uintBitsToFloat(texelFetch(records, int(index))); }
 
+// The walk's end, and the subtree after the one whose last point is `last`, in depth-first order
+// (left child first): it starts at point last + 1, and in Karras's layout an internal node's
+// range has the node's own index at one end, so it is internal node last + 1 if that node's
+// range starts there, else the point itself. No stack: llvmpipe keeps a private array per lane,
+// and the walk's pushes and pops cost more than this one extra texel. (tile_cut.comp, and the
+// re-entry's exitance walk.)
+const uint WALK_END = 0xffffffffu;
+uint walk_next_after(usamplerBuffer tree_nodes, uint point_count, uint node_count, uint last) {
+    uint next = last + 1u;
+    if (next >= point_count) return WALK_END;
+    if (next < node_count && texelFetch(tree_nodes, int(next * NODE_TEXELS + 3u)).z == next) return next;
+    return next | LEAF_BIT;
+}
+
 // Octahedral encoding of a unit vector (Cigolle et al. 2014) into 2×16-bit snorm.
 vec2 oct_wrap(vec2 v) {
     return (1.0 - abs(v.yx)) * vec2(v.x >= 0.0 ? 1.0 : -1.0, v.y >= 0.0 ? 1.0 : -1.0);

@@ -144,3 +144,23 @@ pub struct TileCutConstants {
     /// The frame's model (`Model::gpu_code`): whether the normal enters Sd (the far field's test).
     pub model: u32,
 }
+
+/// Push constants of the re-entry's three stages (shaders/include/reentry.glsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct ReentryConstants {
+    pub patch_count: u32,
+    /// Sorted points per patch (the last patch takes the rest too).
+    pub stride: u32,
+    pub point_count: u32,
+    /// The exitance walk's cut: a node is whole when area < epsilon · distance².
+    pub epsilon: f32,
+    /// Per channel ∫ (1 − w) Sd 2πr dr over the flat profile (xyz), and the reach (w, mm).
+    pub near: [f32; 4],
+    /// ∫ Ft(θo) cos θo dω: exitance per unit of Sd · power.
+    pub exit_integral: f32,
+    /// A patch's area (scene units²) and its square root.
+    pub patch_area: f32,
+    pub eta: f32,
+    pub patch_spacing: f32,
+}

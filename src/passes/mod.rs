@@ -6,6 +6,7 @@ pub mod debug_view;
 pub mod diffuse;
 pub mod far_field;
 pub mod irradiance;
+pub mod reentry;
 pub mod sampling;
 pub mod shade;
 pub mod shadow;
