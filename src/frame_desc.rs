@@ -198,6 +198,17 @@ impl FrameDesc {
                 self.integration.model.name()
             ));
         }
+        if self.integration.reentry && self.integration.model != Model::Mc {
+            return Err(bad_input!(
+                "--reentry: only --model mc draws light that enters again (model {})",
+                self.integration.model.name()
+            ));
+        }
+        if self.integration.reentry && self.integration.brute_force {
+            return Err(bad_input!(
+                "--reentry: not with --brute-force (it sums each light's own records, which hold no light that enters again)"
+            ));
+        }
         if self.width == 0 || self.height == 0 {
             return Err(bad_input!("image size {}x{}: width and height must be at least 1", self.width, self.height));
         }

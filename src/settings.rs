@@ -259,6 +259,12 @@ impl RenderSettings {
         (d.width, d.height) = (args.width, args.height);
         (d.specular, d.roughness) = (!args.no_specular, args.roughness);
         d.scattering = args.scattering.into();
+        // The re-entry needs the object's inside: an open mesh has none.
+        if args.reentry && s.world.objects.iter().any(|o| !o.mesh.is_closed()) {
+            crate::note!(
+                "warning: --reentry: the mesh is not closed (no inside to tell air from): no light enters again"
+            );
+        }
         d.shadow_resolution = args.shadow_resolution;
         d.show = match args.show {
             ShowArg::Shading => Show::Shading,

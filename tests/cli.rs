@@ -76,6 +76,8 @@ fn bad_flag_values() {
     assert_bad_input(&["--epsilon", "-1"], "--epsilon");
     assert_bad_input(&["--model", "pbd", "--scattering", "single"], "--scattering");
     assert_bad_input(&["--scattering", "twice"], "--scattering");
+    assert_bad_input(&["--model", "directional", "--reentry"], "--reentry");
+    assert_bad_input(&["--model", "mc", "--reentry", "--brute-force"], "--brute-force");
 }
 
 #[test]
