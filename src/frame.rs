@@ -665,10 +665,9 @@ impl Renderer {
                         sd_table: &o.sd_table,
                         buffers: &o.reentry,
                     };
-                    rec.scope("re-entry", |rec| {
-                        self.passes.reentry.record(rec, &inputs, &constants)?;
-                        self.passes.hierarchy.record_summaries_again(rec, h)
-                    })?;
+                    // Three stages, each its own timestamp scope, and the tree again.
+                    self.passes.reentry.record(rec, &inputs, &constants)?;
+                    rec.scope("re-entry tree", |rec| self.passes.hierarchy.record_summaries_again(rec, h))?;
                 }
             }
             if let Some(shadows) = &w.opaque_shadows {

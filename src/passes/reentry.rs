@@ -114,43 +114,49 @@ impl ReentryPass {
         let b = inputs.buffers;
         let push = bytemuck::bytes_of(constants);
         let patches = constants.patch_count;
-        rec.dispatch(
-            &self.exitance,
-            &[
-                Bind::Uniform(inputs.object_params),
-                Bind::Texels(inputs.nodes),
-                Bind::Texels(inputs.points),
-                Bind::Texels(inputs.node_flux),
-                Bind::Texels(inputs.point_flux),
-                Bind::Texels(inputs.point_spread),
-                Bind::Texels(inputs.sd_table),
-                Bind::Write(&b.exitance),
-            ],
-            push,
-            [patches.div_ceil(8), 1, 1],
-        )?;
-        rec.dispatch(
-            &self.gather,
-            &[
-                Bind::Texels(inputs.points),
-                Bind::Read(&b.exitance),
-                Bind::Texels(inputs.sd_table),
-                Bind::Write(&b.received),
-            ],
-            push,
-            [patches.div_ceil(64), 1, 1],
-        )?;
-        rec.dispatch(
-            &self.spread,
-            &[
-                Bind::Write(inputs.points),
-                Bind::Write(inputs.point_flux),
-                Bind::Read(&b.received),
-                Bind::Texels(inputs.sd_table),
-            ],
-            push,
-            [constants.point_count.div_ceil(64), 1, 1],
-        )
+        rec.scope("re-entry exitance", |rec| {
+            rec.dispatch(
+                &self.exitance,
+                &[
+                    Bind::Uniform(inputs.object_params),
+                    Bind::Texels(inputs.nodes),
+                    Bind::Texels(inputs.points),
+                    Bind::Texels(inputs.node_flux),
+                    Bind::Texels(inputs.point_flux),
+                    Bind::Texels(inputs.point_spread),
+                    Bind::Texels(inputs.sd_table),
+                    Bind::Write(&b.exitance),
+                ],
+                push,
+                [patches.div_ceil(8), 1, 1],
+            )
+        })?;
+        rec.scope("re-entry gather", |rec| {
+            rec.dispatch(
+                &self.gather,
+                &[
+                    Bind::Texels(inputs.points),
+                    Bind::Read(&b.exitance),
+                    Bind::Texels(inputs.sd_table),
+                    Bind::Write(&b.received),
+                ],
+                push,
+                [patches.div_ceil(64), 1, 1],
+            )
+        })?;
+        rec.scope("re-entry spread", |rec| {
+            rec.dispatch(
+                &self.spread,
+                &[
+                    Bind::Write(inputs.points),
+                    Bind::Write(inputs.point_flux),
+                    Bind::Read(&b.received),
+                    Bind::Texels(inputs.sd_table),
+                ],
+                push,
+                [constants.point_count.div_ceil(64), 1, 1],
+            )
+        })
     }
 }
 
