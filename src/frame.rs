@@ -655,16 +655,7 @@ impl Renderer {
                     let h = &o.hierarchy;
                     let total_area = reentry::total_area(o.point_spacing, h.point_count);
                     let constants = reentry::constants(h.point_count, total_area, profile);
-                    let inputs = ReentryInputs {
-                        object_params: &o.params,
-                        nodes: &h.nodes,
-                        points: &h.sorted_points,
-                        node_flux: &h.node_flux,
-                        point_flux: &h.sorted_point_flux,
-                        point_spread: &h.sorted_point_spread,
-                        sd_table: &o.sd_table,
-                        buffers: &o.reentry,
-                    };
+                    let inputs = ReentryInputs { sources: o.sources(), buffers: &o.reentry };
                     // Three stages, each its own timestamp scope, and the tree again.
                     self.passes.reentry.record(rec, &inputs, &constants)?;
                     rec.scope("re-entry tree", |rec| self.passes.hierarchy.record_summaries_again(rec, h))?;
@@ -736,18 +727,7 @@ impl Renderer {
                 rec.scope("far field", |rec| {
                     far.iter().try_for_each(|&k| {
                         let (o, t) = (&self.world.objects[k], &self.targets);
-                        let h = &o.hierarchy;
-                        let inputs = FarFieldInputs {
-                            object_params: &o.params,
-                            nodes: &h.nodes,
-                            points: &h.sorted_points,
-                            node_flux: &h.node_flux,
-                            point_flux: &h.sorted_point_flux,
-                            point_spread: &h.sorted_point_spread,
-                            sd_table: &o.sd_table,
-                            position: &t.position,
-                            normal: &t.normal,
-                        };
+                        let inputs = FarFieldInputs { sources: o.sources(), position: &t.position, normal: &t.normal };
                         let eye = desc.camera.eye.extend(1.0).to_array();
                         self.passes.far_field.record(rec, variant, &inputs, &self.tile_lists[k], (k as u32, eye))
                     })

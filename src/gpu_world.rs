@@ -445,6 +445,20 @@ fn union(a: (Vec3, Vec3), b: (Vec3, Vec3)) -> (Vec3, Vec3) {
 }
 
 impl GpuObject {
+    /// What sources.glsl reads of it.
+    pub fn sources(&self) -> crate::passes::Sources<'_> {
+        let h = &self.hierarchy;
+        crate::passes::Sources {
+            object_params: &self.params,
+            nodes: &h.nodes,
+            points: &h.sorted_points,
+            node_flux: &h.node_flux,
+            point_flux: &h.sorted_point_flux,
+            point_spread: &h.sorted_point_spread,
+            sd_table: &self.sd_table,
+        }
+    }
+
     fn new(
         ctx: &Context,
         lights: &[Light],

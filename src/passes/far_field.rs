@@ -9,18 +9,13 @@ use std::collections::HashMap;
 use crate::error::Result;
 use crate::gpu::{FarFieldConstants, FAR_FIELD_SAMPLES, FAR_FIELD_TILE};
 use crate::passes::tile_cut::TileLists;
+use crate::passes::Sources;
 use crate::physics::Model;
-use crate::vk::{Bind, Buffer, Context, Image, Pipeline, Recorder};
+use crate::vk::{Bind, Context, Image, Pipeline, Recorder};
 
-/// What one object's far field reads.
+/// What one object's far field reads: its sources, and the G-buffer's positions and normals.
 pub struct FarFieldInputs<'a> {
-    pub object_params: &'a Buffer,
-    pub nodes: &'a Buffer,
-    pub points: &'a Buffer,
-    pub node_flux: &'a Buffer,
-    pub point_flux: &'a Buffer,
-    pub point_spread: &'a Buffer,
-    pub sd_table: &'a Buffer,
+    pub sources: Sources<'a>,
     pub position: &'a Image,
     pub normal: &'a Image,
 }
@@ -64,16 +59,17 @@ impl FarFieldPass {
             .get(&(model, one_light))
             .ok_or_else(|| crate::runtime!("far field: the pipeline of {model:?} was not prepared"))?;
         let constants = FarFieldConstants { tiles: lists.tiles, object, pad: 0, eye };
+        let [params, nodes, points, node_flux, point_flux, point_spread, sd_table] = inputs.sources.binds();
         rec.dispatch(
             pipeline,
             &[
-                Bind::Uniform(inputs.object_params),
-                Bind::Texels(inputs.nodes),
-                Bind::Texels(inputs.points),
-                Bind::Texels(inputs.node_flux),
-                Bind::Texels(inputs.point_flux),
-                Bind::Texels(inputs.point_spread),
-                Bind::Texels(inputs.sd_table),
+                params,
+                nodes,
+                points,
+                node_flux,
+                point_flux,
+                point_spread,
+                sd_table,
                 Bind::StorageImageRead(inputs.position),
                 Bind::StorageImageRead(inputs.normal),
                 Bind::Texels(&lists.far_headers),

@@ -18,6 +18,7 @@
 
 use crate::error::Result;
 use crate::gpu::ReentryConstants;
+use crate::passes::Sources;
 use crate::physics::Model;
 use crate::vk::{self, Bind, Buffer, BufferUsageFlags, Context, MemoryLocation, Pipeline, Recorder};
 
@@ -81,15 +82,10 @@ pub fn patch_point(c: &ReentryConstants, k: u32) -> u32 {
     k * c.stride + c.stride / 2
 }
 
-/// What one object's re-entry reads and writes.
+/// What one object's re-entry reads and writes: its sources (whose sorted points and their
+/// merged records the last stage adds to) and its patches.
 pub struct ReentryInputs<'a> {
-    pub object_params: &'a Buffer,
-    pub nodes: &'a Buffer,
-    pub points: &'a Buffer,
-    pub node_flux: &'a Buffer,
-    pub point_flux: &'a Buffer,
-    pub point_spread: &'a Buffer,
-    pub sd_table: &'a Buffer,
+    pub sources: Sources<'a>,
     pub buffers: &'a ReentryBuffers,
 }
 
@@ -114,30 +110,20 @@ impl ReentryPass {
         let b = inputs.buffers;
         let push = bytemuck::bytes_of(constants);
         let patches = constants.patch_count;
+        let [params, nodes, points, node_flux, point_flux, point_spread, sd_table] = inputs.sources.binds();
         rec.scope("re-entry exitance", |rec| {
-            rec.dispatch(
-                &self.exitance,
-                &[
-                    Bind::Uniform(inputs.object_params),
-                    Bind::Texels(inputs.nodes),
-                    Bind::Texels(inputs.points),
-                    Bind::Texels(inputs.node_flux),
-                    Bind::Texels(inputs.point_flux),
-                    Bind::Texels(inputs.point_spread),
-                    Bind::Texels(inputs.sd_table),
-                    Bind::Write(&b.exitance),
-                ],
-                push,
-                [patches.div_ceil(8), 1, 1],
-            )
+            let binds =
+                [params, nodes, points, node_flux, point_flux, point_spread, sd_table, Bind::Write(&b.exitance)];
+            rec.dispatch(&self.exitance, &binds, push, [patches.div_ceil(8), 1, 1])
         })?;
+        let sources = &inputs.sources;
         rec.scope("re-entry gather", |rec| {
             rec.dispatch(
                 &self.gather,
                 &[
-                    Bind::Texels(inputs.points),
+                    Bind::Texels(sources.points),
                     Bind::Read(&b.exitance),
-                    Bind::Texels(inputs.sd_table),
+                    Bind::Texels(sources.sd_table),
                     Bind::Write(&b.received),
                 ],
                 push,
@@ -148,10 +134,10 @@ impl ReentryPass {
             rec.dispatch(
                 &self.spread,
                 &[
-                    Bind::Write(inputs.points),
-                    Bind::Write(inputs.point_flux),
+                    Bind::Write(sources.points),
+                    Bind::Write(sources.point_flux),
                     Bind::Read(&b.received),
-                    Bind::Texels(inputs.sd_table),
+                    Bind::Texels(sources.sd_table),
                 ],
                 push,
                 [constants.point_count.div_ceil(64), 1, 1],
