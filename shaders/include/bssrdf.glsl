@@ -304,13 +304,25 @@ void exit_terms(usamplerBuffer table, float unit_mm, float r_mm, bool with_tilt,
 // texel `base` (OCCUPANCY_BASE in an object's table) the grid's corner and 1 (0: no grid), its
 // cell size, then one bit per cell, x fastest, four words a texel.
 const int OCCUPANCY_BASE = EXIT_TILT_BASE + 3 * int(EXIT_TILT_ENTRIES);
-// Whether grid cell `at` (in cells from the corner, floored here) is inside; outside the grid no.
-bool occupied(usamplerBuffer table, int base, vec3 at) {
+// The bits of one grid, in texels (mesh::occupancy::GRID_TEXELS): the grown grid's, then the
+// cell centres' (before it was grown).
+const int OCCUPANCY_GRID_TEXELS = int(OCCUPANCY_CELLS * OCCUPANCY_CELLS * OCCUPANCY_CELLS / 128u);
+// Whether cell `at` (in cells from the corner, floored here) of the grid whose bits start at
+// texel `bits` is set; outside the grid no.
+bool grid_bit(usamplerBuffer table, int bits, vec3 at) {
     vec3 c = floor(at);
     if (any(lessThan(c, vec3(0.0))) || any(greaterThanEqual(c, vec3(float(OCCUPANCY_CELLS))))) return false;
     uint bit = uint(c.x) + OCCUPANCY_CELLS * (uint(c.y) + OCCUPANCY_CELLS * uint(c.z));
-    uint word = texelFetch(table, base + 2 + int(bit >> 7u))[(bit >> 5u) & 3u];
+    uint word = texelFetch(table, bits + int(bit >> 7u))[(bit >> 5u) & 3u];
     return (word & (1u << (bit & 31u))) != 0u;
+}
+// Whether grid cell `at` is inside (the grown grid); outside the grid no.
+bool occupied(usamplerBuffer table, int base, vec3 at) {
+    return grid_bit(table, base + 2, at);
+}
+// Whether grid cell `at` has its centre inside (the grid before it was grown: the air's test).
+bool centre_occupied(usamplerBuffer table, int base, vec3 at) {
+    return grid_bit(table, base + 2 + OCCUPANCY_GRID_TEXELS, at);
 }
 // The grid's corner (w: 1, or 0 where there is none) and cell size, read once per pixel.
 struct Occupancy {

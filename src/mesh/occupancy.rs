@@ -23,8 +23,12 @@ pub struct Occupancy {
     /// The grid's corner and cell size per axis, in scene units.
     pub min: Vec3,
     pub cell: Vec3,
-    /// Bit (x + CELLS (y + CELLS z)) set where that cell's centre is inside the mesh.
+    /// Bit (x + CELLS (y + CELLS z)) set where that cell's centre is inside the mesh, grown by
+    /// one cell ([`dilated`]): where a pair's way through the medium is tested.
     pub bits: Vec<u32>,
+    /// The same before it was grown: where light crosses the air (passes::reentry) is tested,
+    /// which the grown grid would call inside within a cell of the surface.
+    pub centres: Vec<u32>,
 }
 
 impl Occupancy {
@@ -100,7 +104,7 @@ impl Occupancy {
                 }
             }
         }
-        Some(Occupancy { min, cell, bits: dilated(&bits) })
+        Some(Occupancy { min, cell, bits: dilated(&bits), centres: bits })
     }
 
     /// Whether the cell holding `p` is inside (outside the grid: no).
@@ -108,14 +112,15 @@ impl Occupancy {
         self.occupied((p - self.min) / self.cell)
     }
 
+    /// Whether the cell holding `p` has its centre inside (the grid before it was grown; outside
+    /// the grid: no): reentry/gather.comp's test of the air.
+    pub fn centre_inside(&self, p: Vec3) -> bool {
+        bit_at(&self.centres, (p - self.min) / self.cell)
+    }
+
     /// Whether cell `at` (in cells from the corner, floored) is inside (bssrdf.glsl `occupied`).
     fn occupied(&self, at: Vec3) -> bool {
-        let c = at.floor();
-        if !c.is_finite() || c.min_element() < 0.0 || c.max_element() >= CELLS as f32 {
-            return false;
-        }
-        let bit = c.x as usize + CELLS * (c.y as usize + CELLS * c.z as usize);
-        self.bits[bit / 32] & (1 << (bit % 32)) != 0
+        bit_at(&self.bits, at)
     }
 
     /// Whether light can go from `a` (normal `na`) to `b` (normal `nb`) inside the object, as
@@ -135,14 +140,14 @@ impl Occupancy {
     }
 
     /// The GPU's texels (after the Sd table's curvature rows; `OCCUPANCY_BASE` in bssrdf.glsl):
-    /// min.xyz and 1 (0: no grid, every chord inside), then cell.xyz, then the bits, four words
-    /// a texel.
+    /// min.xyz and 1 (0: no grid, every chord inside), then cell.xyz, then the grown bits, four
+    /// words a texel, then the centres' bits the same way.
     pub fn texels(grid: Option<&Occupancy>) -> Vec<[u32; 4]> {
         let mut texels = vec![[0u32; 4]; TEXELS];
         if let Some(g) = grid {
             texels[0] = [g.min.x.to_bits(), g.min.y.to_bits(), g.min.z.to_bits(), 1.0f32.to_bits()];
             texels[1] = [g.cell.x.to_bits(), g.cell.y.to_bits(), g.cell.z.to_bits(), 0];
-            for (t, words) in texels[2..].iter_mut().zip(g.bits.chunks_exact(4)) {
+            for (t, words) in texels[2..].iter_mut().zip(g.bits.chunks_exact(4).chain(g.centres.chunks_exact(4))) {
                 t.copy_from_slice(words);
             }
         }
@@ -161,6 +166,16 @@ pub fn joined_inside(grid: Option<&Occupancy>, xi: Vec3, ni: Vec3, xo: Vec3, no:
         return true;
     }
     grid.is_none_or(|g| g.through_medium(xi, ni, xo, no))
+}
+
+/// Bit `at` (in cells from the corner, floored) of a grid's words; outside the grid: no.
+fn bit_at(words: &[u32], at: Vec3) -> bool {
+    let c = at.floor();
+    if !c.is_finite() || c.min_element() < 0.0 || c.max_element() >= CELLS as f32 {
+        return false;
+    }
+    let bit = c.x as usize + CELLS * (c.y as usize + CELLS * c.z as usize);
+    words[bit / 32] & (1 << (bit % 32)) != 0
 }
 
 /// `bits` grown by one cell toward each of its six neighbours. A chord between two points of a
@@ -194,7 +209,9 @@ fn dilated(bits: &[u32]) -> Vec<u32> {
 }
 
 /// Texels of the grid on the GPU.
-pub const TEXELS: usize = 2 + CELLS * CELLS * CELLS / 128;
+pub const TEXELS: usize = 2 + 2 * GRID_TEXELS;
+/// Texels of one grid's bits (bssrdf.glsl's OCCUPANCY_GRID_TEXELS).
+pub const GRID_TEXELS: usize = CELLS * CELLS * CELLS / 128;
 
 #[cfg(test)]
 mod tests {
@@ -213,6 +230,16 @@ mod tests {
         let volume = count as f32 * g.cell.x * g.cell.y * g.cell.z;
         let grown = 4.0 / 3.0 * std::f32::consts::PI * (1.0 + g.cell.x).powi(3);
         assert!((volume / grown - 1.0).abs() < 0.03, "{volume} against {grown}");
+        // Before it was grown, the cells whose centres are inside fill the ball itself, and are
+        // among the grown grid's.
+        let centres: u32 = g.centres.iter().map(|w| w.count_ones()).sum();
+        let volume = centres as f32 * g.cell.x * g.cell.y * g.cell.z;
+        let ball = 4.0 / 3.0 * std::f32::consts::PI;
+        assert!((volume / ball - 1.0).abs() < 0.03, "{volume} against {ball}");
+        assert!(g.centres.iter().zip(&g.bits).all(|(c, b)| c & !b == 0));
+        assert!(
+            g.centre_inside(Vec3::new(0.9, 0.0, 0.0)) && !g.centre_inside(Vec3::new(1.0 + 0.6 * g.cell.x, 0.0, 0.0))
+        );
         // Every chord of a convex body stays inside; one across the torus's hole does not.
         assert!(g.through_medium(Vec3::new(-0.99, 0.0, 0.0), Vec3::NEG_X, Vec3::new(0.0, 0.99, 0.0), Vec3::Y));
         let torus = Occupancy::of(&Mesh::torus(1.0, 0.3, 64, 32)).expect("closed");
@@ -234,6 +261,7 @@ mod tests {
             min: Vec3::splat(-2.0),
             cell: Vec3::splat(4.0 / CELLS as f32),
             bits: vec![0; CELLS * CELLS * CELLS / 32],
+            centres: vec![0; CELLS * CELLS * CELLS / 32],
         };
         for (a, b) in [(0.1f32, 2.0f32), (0.5, 1.0), (1.5, 3.0)] {
             let (pa, pb) = (Vec3::new(a.cos(), a.sin(), 0.0), Vec3::new(b.cos(), b.sin(), 0.0));
