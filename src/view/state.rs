@@ -8,6 +8,7 @@ use crate::error::Result;
 use crate::frame_desc::FrameDesc;
 use crate::materials::Material;
 use crate::output::Exposure;
+use crate::physics::Model;
 use crate::world::World;
 
 use super::controls::{self, Action, Setting};
@@ -30,6 +31,10 @@ pub struct ViewState {
     /// rotation about the up axis on top of it (`--env-rotate`, `env rotate`).
     pub env_frame: glam::Mat3,
     pub env_rotate_deg: f32,
+    /// Whether light that enters again was asked for (`--reentry`): drawn while the model is the
+    /// Monte Carlo table with the tree, off otherwise (so that the model and brute force can
+    /// still be switched).
+    pub reentry: bool,
 }
 
 /// What [`ViewState::apply`] did with an action.
@@ -56,6 +61,7 @@ impl ViewState {
         let env_lights = desc.environment.as_ref().and_then(|e| e.lights().ok()).map_or(0, |l| l.len());
         let env_frame = desc.environment.as_ref().map_or(glam::Mat3::IDENTITY, |e| e.to_world);
         ViewState {
+            reentry: desc.integration.reentry,
             world,
             desc,
             centre: centre.unwrap_or(Vec3::ZERO),
@@ -192,8 +198,14 @@ impl ViewState {
                 }
                 Setting::Specular(on) => d.specular = on,
                 Setting::Roughness(r) => d.roughness = r,
-                Setting::Model(model) => d.integration.model = model,
-                Setting::BruteForce(on) => d.integration.brute_force = on,
+                Setting::Model(model) => {
+                    d.integration.model = model;
+                    d.integration.reentry = self.reentry && model == Model::Mc && !d.integration.brute_force;
+                }
+                Setting::BruteForce(on) => {
+                    d.integration.brute_force = on;
+                    d.integration.reentry = self.reentry && d.integration.model == Model::Mc && !on;
+                }
                 Setting::Show(show) => d.show = show,
                 // The first translucent object's material and samples.
                 of_object => {
@@ -239,7 +251,6 @@ impl ViewState {
 mod tests {
     use super::*;
     use crate::mesh::Mesh;
-    use crate::physics::Model;
     use crate::scene::{Camera, Light};
 
     fn state() -> ViewState {
@@ -263,6 +274,24 @@ mod tests {
         assert_eq!(s.world.objects[0].samples, Some(5000));
         assert_eq!(s.material().unwrap().name, Material::find("skin1").unwrap().name);
         assert_eq!(s.apply(Action::Quit).unwrap(), Applied::Window(Action::Quit));
+    }
+
+    /// Started with `--reentry`, the model and brute force still switch: light that enters
+    /// again is drawn while the Monte Carlo table walks the tree, and again when it comes back.
+    #[test]
+    fn light_that_enters_again_follows_the_model() {
+        let mut s = state();
+        s.desc.integration.model = Model::Mc;
+        s.desc.integration.reentry = true;
+        s.reentry = true;
+        assert_eq!(s.apply(Action::Set(Setting::Model(Model::Directional))).unwrap(), Applied::Edited);
+        assert!(!s.desc.integration.reentry);
+        s.apply(Action::Set(Setting::Model(Model::Mc))).unwrap();
+        assert!(s.desc.integration.reentry);
+        s.apply(Action::Set(Setting::BruteForce(true))).unwrap();
+        assert!(!s.desc.integration.reentry && s.desc.integration.brute_force);
+        s.apply(Action::Set(Setting::BruteForce(false))).unwrap();
+        assert!(s.desc.integration.reentry);
     }
 
     /// Lights are added, moved and removed before the environment's samples; the environment's
