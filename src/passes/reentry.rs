@@ -30,8 +30,9 @@ pub const PATCHES: u32 = 1024;
 /// down, the patch's own irradiance times the profile's integral stands in).
 pub const REACH_SPACINGS: f32 = 3.0;
 
-/// The exitance walk's cut, looser than a pixel's (default 0.1... of the frame): a patch's
-/// exitance is spread over a patch and then by the BSSRDF.
+/// The exitance walk's cut: the frame's default ε (`frame_desc::DEFAULT_EPSILON`), fixed
+/// whatever `--epsilon` says, since a patch's exitance is spread over the patch and then by the
+/// BSSRDF.
 pub const EXITANCE_EPSILON: f32 = 0.2;
 
 /// One object's patches: their exitance (vec4 each) and what they receive (two vec4 each).
