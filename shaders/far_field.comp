@@ -60,6 +60,7 @@ void main() {
         // centre), so that the sixteen sums are of one function.
         vec3 centre = imageLoad(surface_position, origin + ivec2(int(FAR_FIELD_TILE) / 2)).xyz;
         begin_sources(normal_curvature);
+        begin_thickness(xo, no);
         if (MODEL == MODEL_MC) {
             vec3 wo = normalize(pc.eye.xyz - xo);
             exit_along = wo - dot(wo, no) * no;

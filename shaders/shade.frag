@@ -615,6 +615,7 @@ void main() {
     vec3 no = normalize(normal_curvature.xyz);
     own_weight = imageLoad(surface_albedo, pixel).rgb;
     begin_sources(normal_curvature);
+    begin_thickness(xo, no);
     vec3 wo = normalize(pc.eye.xyz - xo);
     if (MODEL == MODEL_MC) {
         exit_along = wo - dot(wo, no) * no;

@@ -185,6 +185,38 @@ vec3 slab_oblique_factor(usamplerBuffer table, vec4 header, float t, vec3 sin2_t
     return factor;
 }
 
+// The slab's lit face (mirrors SlabChannel::reflected_ratio): R_slab(ρ; t)/R_hs(ρ), what a flat
+// slab of thickness t lets out again through the face it was lit on over what the half-space
+// does at the same ρ (light that comes back from deep in a half-space leaves a thin slab through
+// its far face). After the oblique rows, per lookup node SLAB_ENTRIES texels, texel i holding
+// entries i and i + 1 per channel as two f16. `slab_reflected_rows` (once per pixel, t in mm):
+// x the lookup node below t, y the weight of the one above, z reach = t + L, w 1 (0: no slab,
+// t past the last node or no table).
+const int SLAB_REFLECTED_BASE = SLAB_BASE + 1 + int(SLAB_LOOKUP_NODES * SLAB_ENTRIES + SLAB_THICKNESS_NODES * MC_EXIT_BINS)
+                              + int(SLAB_THICKNESS_NODES * SLAB_OBLIQUE_ROWS);
+vec4 slab_reflected_rows(vec4 header, float t) {
+    float unit_mm = header.x;
+    if (!(t > 0.0) || !(unit_mm > 0.0)) return vec4(0.0);
+    float x = 4.0 * (log2(t / unit_mm) - SLAB_FIRST_LOG2);
+    float last = float(SLAB_LOOKUP_NODES - 1u);
+    if (!(x < last)) return vec4(0.0);
+    x = max(x, 0.0);
+    float j = min(floor(x), last - 1.0);
+    return vec4(j, x - j, max(t, exp2(SLAB_FIRST_LOG2) * unit_mm) + unit_mm, 1.0);
+}
+vec3 slab_reflected_at(usamplerBuffer table, int j, float x) {
+    float i = clamp(floor(x), 0.0, float(SLAB_ENTRIES - 1u));
+    float f = clamp(x - i, 0.0, 1.0);
+    uvec3 pairs = texelFetch(table, SLAB_REFLECTED_BASE + j * int(SLAB_ENTRIES) + int(i)).xyz;
+    vec2 red = unpackHalf2x16(pairs.x), green = unpackHalf2x16(pairs.y), blue = unpackHalf2x16(pairs.z);
+    return mix(vec3(red.x, green.x, blue.x), vec3(red.y, green.y, blue.y), f);
+}
+vec3 slab_reflected_ratio(usamplerBuffer table, vec4 rows, float rho) {
+    if (rows.w == 0.0) return vec3(1.0);
+    float u = rho / (rho + rows.z) * float(SLAB_ENTRIES) - 0.5;
+    return mix(slab_reflected_at(table, int(rows.x), u), slab_reflected_at(table, int(rows.x) + 1, u), rows.y);
+}
+
 // The Monte Carlo table's curvature ratios (mirrors gpu::sd_table::CurvatureRatios::lookup,
 // physics::curvature_profile::CurvatureChannel::ratio): C(r; κ), a sphere's (κ = 1/R > 0) or a
 // cavity's (κ < 0) multiple scattering over the half-space's at chord r, multiplying Sp(r).
@@ -199,8 +231,7 @@ vec3 slab_oblique_factor(usamplerBuffer table, vec4 header, float t, vec3 sin2_t
 // x = −1: no ratios).
 // `curvature_ratio` (per pair): the nearest entry of the two rows of incidence around the pair's
 // sin²θi (two fetches), linear in sin²θi between them per channel, held past the last.
-const int CURVATURE_BASE = SLAB_BASE + 1 + int(SLAB_LOOKUP_NODES * SLAB_ENTRIES + SLAB_THICKNESS_NODES * MC_EXIT_BINS)
-                         + int(SLAB_THICKNESS_NODES * SLAB_OBLIQUE_ROWS);
+const int CURVATURE_BASE = SLAB_REFLECTED_BASE + int(SLAB_LOOKUP_NODES * SLAB_ENTRIES);
 const float CURVATURE_FIRST_LOG2 = float(CURVATURE_FIRST_LOG2_PLUS_8) - 8.0;
 vec4 curvature_rows_at(float unit_mm, float kappa);
 vec4 curvature_rows(usamplerBuffer table, float kappa) {

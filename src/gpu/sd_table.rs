@@ -227,7 +227,8 @@ const _: () = assert!(slab_profile::OBLIQUE_ROWS == super::SLAB_OBLIQUE_ROWS as 
 /// per lookup node its ENTRIES texels, texel i holding entries i and i + 1 of T·reach² / scale
 /// per channel as two f16 (as [`SdTable`]: one fetch per node), then per measured node its
 /// EXIT_BINS exit factors h_T (f32 bits), then per measured node its OBLIQUE_ROWS factors of
-/// incidence (f32 bits; `slab_oblique_factor`).
+/// incidence (f32 bits; `slab_oblique_factor`), then per lookup node its ENTRIES texels of the lit
+/// face's ratio to the half-space, entries i and i + 1 as two f16 (`slab_reflected_ratio`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct SlabTransmission {
     pub unit_mm: f32,
@@ -239,6 +240,8 @@ pub struct SlabTransmission {
     pub exit: Vec<[[f32; 3]; slab_profile::EXIT_BINS]>,
     /// Per measured node, per row of incidence.
     pub oblique: Vec<[[f32; 3]; slab_profile::OBLIQUE_ROWS]>,
+    /// Per lookup node, per entry: f16 bits of R_slab/R_hs ([`SlabChannel::reflected`]).
+    pub reflected: Vec<[[u16; 3]; slab_profile::ENTRIES]>,
 }
 
 impl SlabTransmission {
@@ -250,6 +253,7 @@ impl SlabTransmission {
             values: vec![[[0; 3]; slab_profile::ENTRIES]; slab_profile::LOOKUP_NODES],
             exit: vec![[[1.0; 3]; slab_profile::EXIT_BINS]; slab_profile::THICKNESS_NODES],
             oblique: vec![[[1.0; 3]; slab_profile::OBLIQUE_ROWS]; slab_profile::THICKNESS_NODES],
+            reflected: vec![[[half_bits(1.0); 3]; slab_profile::ENTRIES]; slab_profile::LOOKUP_NODES],
         }
     }
 
@@ -278,6 +282,9 @@ impl SlabTransmission {
             oblique: (0..slab_profile::THICKNESS_NODES)
                 .map(|k| std::array::from_fn(|q| [0, 1, 2].map(|c| channels[c].oblique[k][q] as f32)))
                 .collect(),
+            reflected: (0..slab_profile::LOOKUP_NODES)
+                .map(|j| std::array::from_fn(|i| [0, 1, 2].map(|c| half_bits(channels[c].reflected[j][i] as f32))))
+                .collect(),
         }
     }
 
@@ -288,23 +295,36 @@ impl SlabTransmission {
 
     pub fn texels(&self) -> Vec<[u32; 4]> {
         let header = std::iter::once([self.unit_mm, self.scale[0], self.scale[1], self.scale[2]].map(f32::to_bits));
-        let pairs = self.values.iter().flat_map(|node| {
-            (0..slab_profile::ENTRIES).map(move |i| {
-                let next = |c: usize| if i + 1 < slab_profile::ENTRIES { node[i + 1][c] } else { 0 };
-                let pair = |c: usize| node[i][c] as u32 | (next(c) as u32) << 16;
-                [pair(0), pair(1), pair(2), 0]
-            })
-        });
+        // Texel i: entries i and i + 1 (past the last: `beyond`), so that one fetch interpolates.
+        let paired = |nodes: &[[[u16; 3]; slab_profile::ENTRIES]], beyond: Option<u16>| -> Vec<[u32; 4]> {
+            nodes
+                .iter()
+                .flat_map(|node| {
+                    (0..slab_profile::ENTRIES).map(move |i| {
+                        let next = |c: usize| match node.get(i + 1) {
+                            Some(n) => n[c],
+                            None => beyond.unwrap_or(node[i][c]),
+                        };
+                        let pair = |c: usize| node[i][c] as u32 | (next(c) as u32) << 16;
+                        [pair(0), pair(1), pair(2), 0]
+                    })
+                })
+                .collect()
+        };
+        // T falls to 0 past the last entry; the ratio is held there.
+        let pairs = paired(&self.values, Some(0));
         let exit = self.exit.iter().flatten().map(|h| [h[0], h[1], h[2], 0.0].map(f32::to_bits));
         let oblique = self.oblique.iter().flatten().map(|f| [f[0], f[1], f[2], 0.0].map(f32::to_bits));
-        header.chain(pairs).chain(exit).chain(oblique).collect()
+        let reflected = paired(&self.reflected, None);
+        header.chain(pairs).chain(exit).chain(oblique).chain(reflected).collect()
     }
 
     /// Texels after the angular factors.
     pub const TEXELS: usize = 1
         + slab_profile::LOOKUP_NODES * slab_profile::ENTRIES
         + slab_profile::THICKNESS_NODES * slab_profile::EXIT_BINS
-        + slab_profile::THICKNESS_NODES * slab_profile::OBLIQUE_ROWS;
+        + slab_profile::THICKNESS_NODES * slab_profile::OBLIQUE_ROWS
+        + slab_profile::LOOKUP_NODES * slab_profile::ENTRIES;
 }
 
 const _: () = assert!(curvature_profile::CURVATURE_NODES == super::CURVATURE_NODES as usize);

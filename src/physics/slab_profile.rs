@@ -76,6 +76,14 @@ const MAX_SCATTERINGS: u64 = 3_000_000;
 /// had ended at the first node, no light across at all (its 2 mm slab lit from behind: green
 /// 0.937 of the path tracer, all of it single scattering).
 const NEGLIGIBLE: f64 = 1e-4;
+/// Photons each node walks at least, for its lit face's light ([`SlabChannel::reflected`]), and
+/// the half-space's walk it is measured against (capped in scatterings: a medium that absorbs
+/// nothing returns nearly every photon after arbitrarily many). A ratio is taken over three
+/// entries holding at least REFLECTED_LEAST of the half-space's photons (held outward beyond).
+const REFLECTED_PHOTONS: u64 = 100_000;
+const HALF_SPACE_PHOTONS: u64 = 200_000;
+const HALF_SPACE_SCATTERINGS: u64 = 40_000_000;
+const REFLECTED_LEAST: u64 = 400;
 const NEGLIGIBLE_AFTER: u64 = 40_000;
 const BATCH: u64 = 5_000;
 const MAX_COLLISIONS: u32 = 100_000;
@@ -120,6 +128,11 @@ pub struct SlabChannel {
     /// Per node, per row of incidence ([`OBLIQUE_ROWS`]): the fraction let through (two or more
     /// scatterings) by a beam refracted in at that sin²θt, over the normal beam's (row 0: 1).
     pub oblique: Vec<[f64; OBLIQUE_ROWS]>,
+    /// Per lookup node, per entry (the same u = ρ/(ρ + reach_j) as `lookup`): what the slab's lit
+    /// face lets out again (two or more scatterings) over what the half-space's does at the same
+    /// ρ, R_slab(ρ; t)/R_hs(ρ) (1 where the slab is too thick to matter). Light that would have
+    /// come back from deep in a half-space leaves a thin slab through its far face instead.
+    pub reflected: Vec<[f64; ENTRIES]>,
 }
 
 /// sin²θt of row q of [`SlabChannel::oblique`] for relative index `eta`.
@@ -136,6 +149,7 @@ impl super::table_cache::Flat for SlabChannel {
         super::table_cache::push_vec(&mut v, self.lookup.iter().flatten().copied().collect::<Vec<_>>().into_iter());
         super::table_cache::push_vec(&mut v, self.exit.iter().flatten().copied().collect::<Vec<_>>().into_iter());
         super::table_cache::push_vec(&mut v, self.oblique.iter().flatten().copied().collect::<Vec<_>>().into_iter());
+        super::table_cache::push_vec(&mut v, self.reflected.iter().flatten().copied().collect::<Vec<_>>().into_iter());
         v
     }
     fn from_flat(values: &[f64]) -> Option<SlabChannel> {
@@ -150,13 +164,17 @@ impl super::table_cache::Flat for SlabChannel {
         let (sd, lookup) = (rows(t.vec()?)?, rows(t.vec()?)?);
         let exit_flat = t.vec()?;
         let oblique_flat = t.vec()?;
+        let reflected = rows(t.vec()?)?;
         t.end()?;
+        if reflected.len() != LOOKUP_NODES {
+            return None;
+        }
         if !exit_flat.len().is_multiple_of(EXIT_BINS) || oblique_flat.len() != THICKNESS_NODES * OBLIQUE_ROWS {
             return None;
         }
         let exit = exit_flat.chunks_exact(EXIT_BINS).filter_map(|c| c.try_into().ok()).collect();
         let oblique = oblique_flat.chunks_exact(OBLIQUE_ROWS).filter_map(|c| c.try_into().ok()).collect();
-        Some(SlabChannel { unit_mm, transmitted, sd, lookup, exit, oblique })
+        Some(SlabChannel { unit_mm, transmitted, sd, lookup, exit, oblique, reflected })
     }
 }
 
@@ -198,6 +216,7 @@ impl SlabChannel {
             lookup: vec![[0.0; ENTRIES]; LOOKUP_NODES],
             exit: vec![[1.0; EXIT_BINS]; THICKNESS_NODES],
             oblique: vec![[1.0; OBLIQUE_ROWS]; THICKNESS_NODES],
+            reflected: vec![[1.0; ENTRIES]; LOOKUP_NODES],
         };
         if !(sigma_s_reduced > 0.0 && sigma_t > 0.0 && unit_mm > 0.0 && unit_mm.is_finite()) {
             return out;
@@ -206,11 +225,32 @@ impl SlabChannel {
         let exit_norm = super::beam_diffusion::exit_normalisation(m.eta);
         let entry_start = glam::DVec3::new(0.0, 0.0, -1.0);
         let mut peak = 0.0f64; // the largest fraction let through so far
+                               // The half-space's light out again, binned as each node's map bins it: what the nodes'
+                               // lit faces are measured against.
+        let mut half_space = vec![[0u64; ENTRIES]; THICKNESS_NODES];
+        let mut half_space_traced = 0u64;
+        let mut half_space_scatterings = 0u64;
+        while half_space_traced < HALF_SPACE_PHOTONS && half_space_scatterings < HALF_SPACE_SCATTERINGS {
+            let seed = (0x51ab_ffff_0000_0000 + half_space_traced / BATCH, MAX_COLLISIONS);
+            half_space_scatterings += halfspace::trace_half_space(albedo, m.eta, entry_start, BATCH, seed, |e| {
+                if e.scatterings < 2 {
+                    return;
+                }
+                let rho = (e.x * e.x + e.y * e.y).sqrt() / sigma_t;
+                for (k, counts) in half_space.iter_mut().enumerate() {
+                    let u = rho / (rho + reach_mm(unit_mm, k));
+                    counts[((u * ENTRIES as f64) as usize).min(ENTRIES - 1)] += 1;
+                }
+            });
+            half_space_traced += BATCH;
+        }
+        let mut reflected_nodes = vec![[1.0f64; ENTRIES]; THICKNESS_NODES];
         for k in 0..THICKNESS_NODES {
             let thickness_mfp = node_thickness(k) * unit_mm * sigma_t;
             let reach = reach_mm(unit_mm, k);
             let mut counts = [0u64; ENTRIES];
             let mut exit_counts = [0u64; EXIT_BINS];
+            let mut back = [0u64; ENTRIES]; // out again through the lit face
             let (mut traced, mut through, mut scatterings) = (0u64, 0u64, 0u64);
             // Photons let through after each batch (the oblique rows compare over the first ones).
             let mut through_after = Vec::new();
@@ -220,19 +260,23 @@ impl SlabChannel {
                     && thickness_mfp >= 1.0
                     && (through as f64) < peak * traced as f64
             };
-            while through < TRANSMITTED
+            while (through < TRANSMITTED || traced < REFLECTED_PHOTONS)
                 && traced < MAX_PHOTONS
                 && scatterings < MAX_SCATTERINGS
                 && !negligible(through, traced)
             {
                 let seed = (0x51ab_0000_0000 + ((k as u64) << 32) + traced / BATCH, MAX_COLLISIONS);
                 scatterings += halfspace::trace_slab(albedo, m.eta, thickness_mfp, entry_start, BATCH, seed, |e| {
-                    if !e.transmitted || e.scatterings < 2 {
+                    if e.scatterings < 2 {
+                        return;
+                    }
+                    let rho = (e.x * e.x + e.y * e.y).sqrt() / sigma_t;
+                    let u = rho / (rho + reach);
+                    if !e.transmitted {
+                        back[((u * ENTRIES as f64) as usize).min(ENTRIES - 1)] += 1;
                         return;
                     }
                     through += 1;
-                    let rho = (e.x * e.x + e.y * e.y).sqrt() / sigma_t;
-                    let u = rho / (rho + reach);
                     counts[((u * ENTRIES as f64) as usize).min(ENTRIES - 1)] += 1;
                     exit_counts[((e.mu_o2 * EXIT_BINS as f64) as usize).min(EXIT_BINS - 1)] += 1;
                 });
@@ -242,6 +286,7 @@ impl SlabChannel {
             if negligible(through, traced) {
                 break;
             }
+            reflected_nodes[k] = reflected_ratio(&back, traced, &half_space[k], half_space_traced);
             let fraction = through as f64 / traced as f64;
             peak = peak.max(fraction);
             out.transmitted[k] = fraction;
@@ -294,7 +339,45 @@ impl SlabChannel {
         }
         out.lookup =
             (0..LOOKUP_NODES).map(|j| std::array::from_fn(|i| out.measured_scaled(j, entry_centre(i)))).collect();
+        // Between measured nodes, linearly at the same u (a ratio, near 1 where it matters least).
+        out.reflected = (0..LOOKUP_NODES)
+            .map(|j| {
+                let (k, odd) = (j / 2, j % 2 == 1);
+                std::array::from_fn(|i| {
+                    if odd {
+                        0.5 * (reflected_nodes[k][i] + reflected_nodes[k + 1][i])
+                    } else {
+                        reflected_nodes[k][i]
+                    }
+                })
+            })
+            .collect();
         out
+    }
+
+    /// R_slab(ρ; t)/R_hs(ρ) on the lit face (the f64 mirror of bssrdf.glsl's
+    /// `slab_reflected_ratio`): between lookup nodes linearly in log t at the same
+    /// u = ρ/(ρ + reach), reach = t + L, and between the entries' centres (held below the first
+    /// and past the last); 1 past the last node.
+    pub fn reflected_ratio(&self, rho_mm: f64, thickness_mm: f64) -> f64 {
+        if thickness_mm.is_nan() || thickness_mm <= 0.0 {
+            return 1.0;
+        }
+        let x = lookup_coordinate(thickness_mm / self.unit_mm);
+        let last = (LOOKUP_NODES - 1) as f64;
+        if x >= last {
+            return 1.0;
+        }
+        let x = x.max(0.0);
+        let j = (x.floor() as usize).min(LOOKUP_NODES - 2);
+        let reach = thickness_mm.max(self.unit_mm * node_thickness(0)) + self.unit_mm;
+        let u = rho_mm / (rho_mm + reach);
+        let at = |j: usize| {
+            let e = (u * ENTRIES as f64 - 0.5).clamp(0.0, (ENTRIES - 1) as f64);
+            let i = (e.floor() as usize).min(ENTRIES - 2);
+            self.reflected[j][i] + (self.reflected[j][i + 1] - self.reflected[j][i]) * (e - i as f64)
+        };
+        at(j) + (at(j + 1) - at(j)) * (x - j as f64)
     }
 
     /// The measured nodes' T·reach² at lookup node `j` and u: node j/2 itself for even j; between
@@ -398,6 +481,34 @@ fn between_entries(entries: &[f64; ENTRIES], u: f64) -> f64 {
     let a = entries[i.min(ENTRIES - 1)];
     let b = if i + 1 < ENTRIES { entries[i + 1] } else { 0.0 };
     a + (b - a) * f
+}
+
+/// Per entry, a slab node's light out of its lit face over the half-space's (`back` of `traced`
+/// photons against `half_space` of `half_space_traced`, binned alike), each over three entries
+/// (the noise of a bin's few photons far out): 1 where the half-space has too few to say.
+fn reflected_ratio(
+    back: &[u64; ENTRIES],
+    traced: u64,
+    half_space: &[u64; ENTRIES],
+    half_space_traced: u64,
+) -> [f64; ENTRIES] {
+    let window = |c: &[u64; ENTRIES], i: usize| c[i.saturating_sub(1)..(i + 2).min(ENTRIES)].iter().sum::<u64>();
+    // A slab whose lit face gives back all but 0.5% of the half-space's is one (its bins' ratios
+    // would be noise about 1: the 20 mm textured slab's red moved +0.6%).
+    let total = |c: &[u64; ENTRIES]| c.iter().sum::<u64>() as f64;
+    if traced == 0 || total(back) / traced as f64 >= 0.995 * total(half_space) / half_space_traced as f64 {
+        return [1.0; ENTRIES];
+    }
+    let mut held = 1.0;
+    std::array::from_fn(|i| {
+        let (b, h) = (window(back, i), window(half_space, i));
+        if h >= REFLECTED_LEAST && traced > 0 {
+            // At most 1: the far face only takes light away (where ρ ≪ t none reaches it; above
+            // 1 is a bin's noise).
+            held = ((b as f64 / traced as f64) / (h as f64 / half_space_traced as f64)).min(1.0);
+        }
+        held
+    })
 }
 
 fn smoothstep(e0: f64, e1: f64, x: f64) -> f64 {
