@@ -172,14 +172,7 @@ fn gpu_curvature_terms_match_cpu() {
     let mut texels = vec![[0u32; 4]; TABLE_SIZE + AngularFactors::TEXELS + SlabTransmission::TEXELS];
     texels.extend(ratios.texels());
 
-    // A small deterministic generator (xorshift).
-    let mut state = 0x9e37_79b9_7f4a_7c15u64;
-    let mut uniform = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut uniform = xorshift(0x9e37_79b9_7f4a_7c15);
     let n = 4096;
     let queries: Vec<[[f32; 4]; 2]> = (0..n)
         .map(|i| {
@@ -339,13 +332,7 @@ fn gpu_slab_reflected_ratio_matches_cpu() {
     let unit = channels[0].unit_mm;
     let mut texels = vec![[0u32; 4]; TABLE_SIZE + AngularFactors::TEXELS];
     texels.extend(slab.texels());
-    let mut state = 0x5eed_1234_abcd_0001u64;
-    let mut uniform = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut uniform = xorshift(0x5eed_1234_abcd_0001);
     let n = 4096;
     let queries: Vec<[f32; 2]> = (0..n)
         .map(|_| [(40.0 * unit * uniform().powi(2)) as f32, (unit * 2f64.powf(-5.0 + 12.5 * uniform())) as f32])
@@ -378,4 +365,15 @@ fn gpu_slab_reflected_ratio_matches_cpu() {
     }
     println!("{n} queries, {sheets} read as a sheet; worst difference {worst:.1e}");
     assert!(sheets > n / 2 && sheets < n, "{sheets} of {n} read as a sheet");
+}
+
+/// A small deterministic generator (xorshift) of uniform numbers in [0, 1).
+fn xorshift(seed: u64) -> impl FnMut() -> f64 {
+    let mut state = seed;
+    move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    }
 }
