@@ -666,7 +666,7 @@ fn thin_slab_against_its_walk(material: &str, thickness_mm: f32, lit_face: bool,
 }
 
 /// The Monte Carlo table on the lit face of thin slabs against the slab's walk
-/// (`thin_slab_against_its_walk`), within 5%: measured Marble 2 mm 0.985 0.966 0.959, 4 mm 1.012 1.006 1.011, Skin1 2 mm 1.044
+/// (`thin_slab_against_its_walk`), within 5%: measured Marble 2 mm 0.984 0.965 0.959, 4 mm 1.011 1.005 1.010, Skin1 2 mm 1.043
 /// 0.997 0.989. Read as the half-space (before sources.glsl `begin_thickness`), the light that a
 /// half-space gives back from deep down and a sheet lets out of its far face made Marble's 2 mm
 /// 1.356 1.228 1.146, 4 mm 1.108 1.020 0.970 (at 60,000 points) and Skin1's red 1.370.

@@ -308,11 +308,23 @@ void node_sigma(uint index, vec3 ni, vec3 xo, out vec3 center, out vec3 offset, 
 }
 
 // The object's thickness (mm) under xo along −no: the distance to where the inside grid's cell
-// centres (the un-grown grid) are outside again, in steps of half the smallest cell, after at
+// centres (the un-grown grid) are outside again, in steps of half the smallest cell (then
+// refined on the interpolated field, inside_field), after at
 // most two cells of air at the start (the surface cuts xo's own cell). None inside within those
 // two cells (a sheet thinner than the grid resolves), past THICKEST_STEPS, or no grid (an open
 // mesh): 0, no sheet.
 const float THICKEST_STEPS = 256.0;
+// The cell centres' bits (the un-grown grid) interpolated trilinearly at `at` (in cells).
+float inside_field(vec3 at) {
+    vec3 p = at - 0.5, c = floor(p), f = p - c;
+    float sum = 0.0;
+    for (int k = 0; k < 8; ++k) {
+        vec3 o = vec3(float(k & 1), float((k >> 1) & 1), float(k >> 2));
+        vec3 w = mix(vec3(1.0) - f, f, o);
+        sum += centre_occupied(dipole_table, OCCUPANCY_BASE, c + o + 0.5) ? w.x * w.y * w.z : 0.0;
+    }
+    return sum;
+}
 float thickness_below(vec3 xo, vec3 no) {
     if (object_inside.corner.w == 0.0) return 0.0;
     vec3 cell = object_inside.cell;
@@ -329,7 +341,17 @@ float thickness_below(vec3 xo, vec3 no) {
         }
     }
     if (first == 0.0 || last >= THICKEST_STEPS) return 0.0;
-    return (last + 0.5) * step_units * object_params.mm_per_unit;
+    // Where the far face is: the cells' bits alone move it a step at a time, and the sheet's
+    // ratio with it, which mottled an ear seen at a slant. The centres' bits interpolated
+    // trilinearly are a field that changes smoothly; its level ½ between the steps around
+    // the last inside one, by bisection.
+    float lo = last - 1.0, hi = last + 1.0;
+    for (int k = 0; k < 5; ++k) {
+        float mid = 0.5 * (lo + hi);
+        if (inside_field(start + d * mid) >= 0.5) lo = mid;
+        else hi = mid;
+    }
+    return 0.5 * (lo + hi) * step_units * object_params.mm_per_unit;
 }
 
 // Sets the pixel's sheet (thin_rows, thin_weight) for the Monte Carlo table: the slab's lit face
@@ -344,10 +366,6 @@ void begin_thickness(vec3 xo, vec3 no) {
     thin_rows = slab_reflected_rows(slab_header, t);
     if (thin_rows.w == 0.0) return;
     thin_weight = 1.0 - clamp(2.0 * pixel_curvature_mm * t - 1.0, 0.0, 1.0);
-    // A sheet a few cells thin is the grid's guess (a lip of the bunny's base read 0.3 mm and
-    // drew black speckles): the correction fades in from two cells to four.
-    float cell_mm = min(object_inside.cell.x, min(object_inside.cell.y, object_inside.cell.z)) * object_params.mm_per_unit;
-    thin_weight *= smoothstep(2.0 * cell_mm, 4.0 * cell_mm, t);
 }
 
 // The per-pixel state of the sources above, from the pixel's normal and mean curvature (the
