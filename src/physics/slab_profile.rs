@@ -108,6 +108,15 @@ pub fn node_coordinate(thickness: f64) -> f64 {
     2.0 * (thickness.log2() - FIRST_NODE_LOG2 as f64)
 }
 
+/// Thickness t read between lookup nodes: its lookup coordinate x (≥ 0), the node j below it and
+/// the weight a of j + 1, and reach = t + L (mm), the scale of both nodes' radial maps there.
+struct LookupPlace {
+    x: f64,
+    j: usize,
+    a: f64,
+    reach: f64,
+}
+
 /// One channel's transmission profiles.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SlabChannel {
@@ -360,24 +369,30 @@ impl SlabChannel {
     /// u = ρ/(ρ + reach), reach = t + L, and between the entries' centres (held below the first
     /// and past the last); 1 past the last node.
     pub fn reflected_ratio(&self, rho_mm: f64, thickness_mm: f64) -> f64 {
-        if thickness_mm.is_nan() || thickness_mm <= 0.0 {
-            return 1.0;
-        }
-        let x = lookup_coordinate(thickness_mm / self.unit_mm);
-        let last = (LOOKUP_NODES - 1) as f64;
-        if x >= last {
-            return 1.0;
-        }
-        let x = x.max(0.0);
-        let j = (x.floor() as usize).min(LOOKUP_NODES - 2);
-        let reach = thickness_mm.max(self.unit_mm * node_thickness(0)) + self.unit_mm;
-        let u = rho_mm / (rho_mm + reach);
+        let Some(place) = self.lookup_place(thickness_mm) else { return 1.0 };
+        let u = rho_mm / (rho_mm + place.reach);
         let at = |j: usize| {
             let e = (u * ENTRIES as f64 - 0.5).clamp(0.0, (ENTRIES - 1) as f64);
             let i = (e.floor() as usize).min(ENTRIES - 2);
             self.reflected[j][i] + (self.reflected[j][i + 1] - self.reflected[j][i]) * (e - i as f64)
         };
-        at(j) + (at(j + 1) - at(j)) * (x - j as f64)
+        at(place.j) + (at(place.j + 1) - at(place.j)) * place.a
+    }
+
+    /// Where thickness t (mm) is read between lookup nodes (bssrdf.glsl's `slab_transmission` and
+    /// `slab_reflected_rows` alike): None for no thickness or past the last node.
+    fn lookup_place(&self, thickness_mm: f64) -> Option<LookupPlace> {
+        if thickness_mm.is_nan() || thickness_mm <= 0.0 {
+            return None;
+        }
+        let x = lookup_coordinate(thickness_mm / self.unit_mm);
+        if x >= (LOOKUP_NODES - 1) as f64 {
+            return None;
+        }
+        let x = x.max(0.0);
+        let j = (x.floor() as usize).min(LOOKUP_NODES - 2);
+        let reach = thickness_mm.max(self.unit_mm * node_thickness(0)) + self.unit_mm;
+        Some(LookupPlace { x, j, a: x - j as f64, reach })
     }
 
     /// The measured nodes' T·reach² at lookup node `j` and u: node j/2 itself for even j; between
@@ -422,18 +437,8 @@ impl SlabChannel {
     /// units of reach² (a profile's width grows with t + L, so that is a change of scale between
     /// nodes, not a blur of two widths), linearly in log t; faded to 0 over the last half octave.
     pub fn sd(&self, rho_mm: f64, thickness_mm: f64) -> f64 {
-        if thickness_mm.is_nan() || thickness_mm <= 0.0 {
-            return 0.0;
-        }
-        let x = lookup_coordinate(thickness_mm / self.unit_mm);
+        let Some(LookupPlace { x, j, a, reach }) = self.lookup_place(thickness_mm) else { return 0.0 };
         let last = (LOOKUP_NODES - 1) as f64;
-        if x >= last {
-            return 0.0;
-        }
-        let x = x.max(0.0);
-        let j = (x.floor() as usize).min(LOOKUP_NODES - 2);
-        let a = x - j as f64;
-        let reach = thickness_mm.max(self.unit_mm * node_thickness(0)) + self.unit_mm;
         let u = rho_mm / (rho_mm + reach);
         let (v0, v1) = (self.lookup_scaled(j, u), self.lookup_scaled(j + 1, u));
         (v0 + (v1 - v0) * a) / (reach * reach) * (1.0 - smoothstep(last - 2.0, last, x))
